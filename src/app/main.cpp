@@ -1,0 +1,267 @@
+// dem2d: command line, wiring and exit codes (interface.md). Everything else lives in the
+// libraries: the deck and outputs in src/io, the physics in src/core, MPI in src/parallel.
+//
+// Exit status: 0 success, 2 bad input or usage, 3 the run became unstable, 4 an I/O failure.
+// Every rank parses and validates the same deck, so every rank reaches the same verdict and
+// exits with the same status; rank 0 alone prints.
+#include <mpi.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/simulation.hpp"
+#include "io/deck.hpp"
+#include "io/output_dir.hpp"
+#include "io/run_json.hpp"
+#include "io/series.hpp"
+#include "io/snapshots.hpp"
+
+namespace {
+
+using namespace dem2d;
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string deck;
+  std::vector<std::string> sets;
+  std::string output;
+  std::string restart;
+  bool check = false;
+  bool quiet = false;
+};
+
+int g_rank = 0;
+int g_size = 1;
+
+void say(const std::string& text, FILE* stream = stdout) {
+  if (g_rank == 0) {
+    std::fputs(text.c_str(), stream);
+    std::fflush(stream);
+  }
+}
+
+std::string fmt_double(const char* format, double x) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
+
+// Derived quantities of a scene (--check).
+void print_check(const Simulation& sim) {
+  const Scene& s = sim.scene();
+  const ParticleStore& p = sim.particles();
+  const TimeScales& ts = sim.scales();
+  std::string out = "dem2d --check " + s.deck_path + ": the deck is valid\n";
+  if (!s.title.empty()) out += "  title:                 " + s.title + "\n";
+  out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
+  double area = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) area += std::numbers::pi * p.radius[k] * p.radius[k];
+  const double g = norm(s.run.gravity);
+  if (s.drum.present) {
+    const double R = s.drum.radius;
+    const double phi = area / (std::numbers::pi * R * R);
+    const double w_classic = std::sqrt(g / R);
+    const double w_thesis = std::pow(1.0 - std::min(phi, 0.99), -0.25) * w_classic;  // T37
+    out += fmt_double("  fill fraction:         %.4f (particle cross-sections / drum area)\n", phi);
+    out += fmt_double("  critical speed:        %.4f rad/s", w_classic) +
+           fmt_double(" = sqrt(g/R) (%.2f rpm);", w_classic * 30.0 / std::numbers::pi) +
+           fmt_double(" with fill (thesis T37) %.4f rad/s\n", w_thesis);
+    out += fmt_double("  drum speed:            %.4f rad/s", s.drum.speed) +
+           fmt_double(" = %.3f of critical", s.drum.speed / w_classic) +
+           fmt_double(" (Froude number %.4f)\n", s.drum.speed * s.drum.speed * R / g);
+  }
+  out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
+  out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
+         fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
+  out += fmt_double("  safe dt:               %.4e s (dt = \"auto\")", ts.safe_dt) +
+         fmt_double("; refused above %.4e s\n", ts.limit_dt);
+  out += fmt_double("  chosen dt:             %.4e s", sim.dt()) +
+         fmt_double(" (%.3f of the safe dt)\n", sim.dt() / ts.safe_dt);
+  const double steps = std::ceil(s.run.duration / sim.dt() - 0.5);
+  out += fmt_double("  steps:                 %.0f", steps) +
+         fmt_double(" for %.4g s simulated\n", s.run.duration);
+  const double bytes = static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
+                       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * sizeof(ContactHistory));
+  out += fmt_double("  memory estimate:       %.1f MiB\n", 2.0 * bytes / (1024.0 * 1024.0));
+  out += fmt_double("  neighbour skin:        %.4g m\n", sim.skin());
+  say(out);
+}
+
+class Progress {
+ public:
+  Progress(bool quiet, double duration, double interval)
+      : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), duration_(duration), interval_(interval),
+        start_(Clock::now()), last_(start_) {}
+  void update(const Simulation& sim, bool final_line = false) {
+    if (quiet_ || g_rank != 0) return;
+    const auto now = Clock::now();
+    const double since = std::chrono::duration<double>(now - last_).count();
+    if (!final_line && since < (tty_ ? 0.5 : interval_)) return;
+    last_ = now;
+    const double wall = std::chrono::duration<double>(now - start_).count();
+    const double rate = wall > 0 ? static_cast<double>(sim.particles().n_owned()) * sim.step_count() / wall : 0;
+    const double frac = sim.time() / duration_;
+    const double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  "step %lld  t = %.4f / %.4g s  particles %zu  %.3g particle-steps/s  ETA %.0f s",
+                  static_cast<long long>(sim.step_count()), sim.time(), duration_,
+                  sim.particles().n_owned(), rate, eta);
+    if (tty_)
+      std::fprintf(stderr, "\r%s\033[K%s", line, final_line ? "\n" : "");
+    else
+      std::fprintf(stderr, "%s\n", line);
+    std::fflush(stderr);
+  }
+
+ private:
+  bool quiet_, tty_;
+  double duration_, interval_;
+  Clock::time_point start_, last_;
+};
+
+// Rank 0 owns every particle for output until the decomposition lands (issue 3): the other
+// ranks run the same deterministic simulation and write nothing.
+const ParticleStore& output_view(const Simulation& sim) {
+  static const ParticleStore empty;
+  return g_rank == 0 ? sim.particles() : empty;
+}
+
+int run(const Options& opt) {
+  Scene scene = load_deck(opt.deck, opt.sets);
+  if (!opt.output.empty()) scene.output.directory = opt.output;
+  if (!opt.restart.empty())
+    throw InputError("--restart " + opt.restart + ": error: restarting from a checkpoint is not implemented yet");
+  Simulation sim(scene);
+  if (opt.check) {
+    print_check(sim);
+    return kExitOk;
+  }
+  const OutputSpec& out = scene.output;
+  prepare_output_directory(MPI_COMM_WORLD, out.directory);
+  SeriesWriter series(out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative,
+                      g_rank == 0);
+  SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
+  if (!opt.quiet)
+    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(sim.particles().n_owned()) +
+        " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
+        (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory + "\n");
+
+  const double dt = sim.dt();
+  const auto at_multiple = [dt](double t, double interval) {
+    if (interval <= 0.0) return false;
+    const double k = std::round(t / interval);
+    return std::abs(t - k * interval) < 0.5 * dt;
+  };
+  Progress progress(opt.quiet, scene.run.duration, out.progress_interval);
+  const auto start = Clock::now();
+  double last_snapshot_time = -1.0;
+  series.write(sim.diagnostics());
+  sim.reset_pass_window();
+  if (out.snapshot_interval > 0) {
+    snapshots.write(output_view(sim), sim.time(), sim.step_count());
+    last_snapshot_time = sim.time();
+  }
+  try {
+    while (sim.time() + 0.5 * dt < scene.run.duration) {
+      sim.step();
+      if (at_multiple(sim.time(), out.series_interval)) {
+        series.write(sim.diagnostics());
+        sim.reset_pass_window();
+      }
+      if (at_multiple(sim.time(), out.snapshot_interval)) {
+        snapshots.write(output_view(sim), sim.time(), sim.step_count());
+        last_snapshot_time = sim.time();
+      }
+      progress.update(sim);
+    }
+  } catch (const UnstableError& e) {
+    snapshots.write(output_view(sim), sim.time(), sim.step_count());
+    say(scene.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
+            "/snapshots.h5\n",
+        stderr);
+    return kExitUnstable;
+  }
+  if (last_snapshot_time != sim.time()) snapshots.write(output_view(sim), sim.time(), sim.step_count());
+  if (!at_multiple(sim.time(), out.series_interval)) series.write(sim.diagnostics());
+  progress.update(sim, true);
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  RunInfo info;
+  info.version = DEM2D_VERSION;
+  info.ranks = g_size;
+  info.wall_time_s = wall;
+  info.steps = sim.step_count();
+  info.particle_steps_per_second =
+      wall > 0 ? static_cast<double>(sim.particles().n_owned()) * sim.step_count() / wall : 0.0;
+  info.dt = sim.dt();
+  info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
+  if (scene.run.integrator == IntegratorKind::kIterative) {
+    info.extra.emplace_back("mean_passes", fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
+                                                                  std::max<std::int64_t>(1, sim.step_count())));
+    info.extra.emplace_back("unconverged_steps", std::to_string(sim.unconverged_steps()));
+  }
+  if (g_rank == 0) write_run_json(out.directory + "/run.json", scene, info);
+  if (!opt.quiet)
+    say(fmt_double("done: %.4g s simulated", sim.time()) + fmt_double(" in %.3g s of wall time", wall) +
+        fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
+  if (sim.unconverged_steps() > 0)
+    say("warning: the iterative integrator did not converge in " + std::to_string(sim.unconverged_steps()) +
+            " steps (run.max_passes = " + std::to_string(scene.run.max_passes) + ")\n",
+        stderr);
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+
+  CLI::App app{"dem2d: 2D discrete element simulator of tumbling ball mills"};
+  Options opt;
+  app.add_option("INPUT", opt.deck, "input deck (.in, TOML)");
+  app.add_flag("--check", opt.check, "validate the deck, print derived quantities, run nothing");
+  app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)");
+  app.add_option("--output", opt.output, "output directory (overrides output.directory)");
+  app.add_option("--restart", opt.restart, "continue from a checkpoint file");
+  app.add_flag("--quiet", opt.quiet, "no progress line");
+  bool version = false;
+  app.add_flag("--version", version, "print the version and exit");
+
+  int code = kExitOk;
+  try {
+    app.parse(argc, argv);
+    if (version) {
+      say("dem2d " DEM2D_VERSION "\n");
+    } else if (opt.deck.empty()) {
+      say("dem2d: error: no input deck given\nRun with --help for more information.\n", stderr);
+      code = kExitInput;
+    } else {
+      code = run(opt);
+    }
+  } catch (const CLI::ParseError& e) {
+    if (g_rank == 0) code = app.exit(e);
+    code = e.get_exit_code() == 0 ? kExitOk : kExitInput;
+  } catch (const InputError& e) {
+    for (const std::string& m : e.messages()) say(m + "\n", stderr);
+    code = kExitInput;
+  } catch (const IoError& e) {
+    say(std::string("dem2d: error: ") + e.what() + "\n", stderr);
+    code = kExitIo;
+  } catch (const std::exception& e) {
+    say(std::string("dem2d: internal error: ") + e.what() + "\n", stderr);
+    code = 1;
+  }
+  MPI_Finalize();
+  return code;
+}

@@ -1,0 +1,72 @@
+#include "core/particles.hpp"
+
+#include <numbers>
+#include <stdexcept>
+
+namespace dem2d {
+
+std::size_t ParticleStore::bytes_per_particle() const {
+  std::size_t b = 0;
+  for (const FieldBase* f : registry_) b += f->bytes_per_item();
+  return b;
+}
+
+double ParticleStore::sphere_mass(double r, double density) {
+  return 4.0 / 3.0 * std::numbers::pi * r * r * r * density;
+}
+
+void ParticleStore::resize_all(std::size_t n) {
+  for (FieldBase* f : registry_) f->resize(n);
+}
+
+std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, double density,
+                               Vec2 x, Vec2 v, double spin) {
+  if (n_ghost() != 0) throw std::logic_error("ParticleStore::add with ghosts present");
+  const std::size_t i = size();
+  resize_all(i + 1);
+  id[i] = pid;
+  material[i] = mat;
+  pos[i] = x;
+  vel[i] = v;
+  acc[i] = {};
+  theta[i] = 0.0;
+  omega[i] = spin;
+  alpha[i] = 0.0;
+  radius[i] = r;
+  const double m = sphere_mass(r, density);
+  mass[i] = m;
+  inv_mass[i] = 1.0 / m;
+  inv_inertia[i] = 1.0 / sphere_inertia(m, r);
+  force[i] = {};
+  torque[i] = 0.0;
+  n_owned_ = i + 1;
+  return i;
+}
+
+void ParticleStore::remove_if(const std::vector<char>& remove) {
+  clear_ghosts();
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < n_owned_; ++i) {
+    if (remove[i]) continue;
+    if (k != i)
+      for (FieldBase* f : registry_) f->copy_item(k, i);
+    ++k;
+  }
+  resize_all(k);
+  n_owned_ = k;
+}
+
+void ParticleStore::permute(const std::vector<std::size_t>& order) {
+  clear_ghosts();
+  for (FieldBase* f : registry_) f->permute(order);
+}
+
+void ParticleStore::clear_ghosts() { resize_all(n_owned_); }
+
+std::size_t ParticleStore::add_ghosts(std::size_t n) {
+  const std::size_t first = size();
+  resize_all(first + n);
+  return first;
+}
+
+}  // namespace dem2d

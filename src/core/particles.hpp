@@ -1,0 +1,124 @@
+// ParticleStore: structure-of-arrays particle storage driven by one field registry.
+//
+// Each per-particle quantity is a named column (`Field<T>`). Every column registers itself,
+// so resizing, removing, reordering, packing for migration and writing snapshots go through
+// one list: a new field is added in one place. Owned particles occupy [0, n_owned); ghosts
+// (copies of other ranks' particles, parallel runs only) follow in [n_owned, size()).
+//
+// Conventions (physics.md section 1): a particle is a sphere whose centre moves in the
+// plane; mass m = 4/3 pi r^3 rho, moment of inertia I = 2/5 m r^2; angles and spins are
+// counter-clockwise positive.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "core/vec2.hpp"
+
+namespace dem2d {
+
+class FieldBase {
+ public:
+  explicit FieldBase(std::string name) : name_(std::move(name)) {}
+  virtual ~FieldBase() = default;
+  FieldBase(const FieldBase&) = delete;
+  FieldBase& operator=(const FieldBase&) = delete;
+
+  const std::string& name() const { return name_; }
+  virtual std::size_t bytes_per_item() const = 0;
+  virtual void resize(std::size_t n) = 0;
+  virtual void copy_item(std::size_t dst, std::size_t src) = 0;
+  virtual void pack(std::size_t i, std::byte* out) const = 0;
+  virtual void unpack(std::size_t i, const std::byte* in) = 0;
+  virtual void permute(const std::vector<std::size_t>& order) = 0;  // new[k] = old[order[k]]
+
+ private:
+  std::string name_;
+};
+
+template <class T>
+class Field final : public FieldBase {
+ public:
+  Field(std::string name, std::vector<FieldBase*>& registry) : FieldBase(std::move(name)) {
+    registry.push_back(this);
+  }
+  std::size_t bytes_per_item() const override { return sizeof(T); }
+  void resize(std::size_t n) override { data_.resize(n); }
+  void copy_item(std::size_t dst, std::size_t src) override { data_[dst] = data_[src]; }
+  void pack(std::size_t i, std::byte* out) const override { std::memcpy(out, &data_[i], sizeof(T)); }
+  void unpack(std::size_t i, const std::byte* in) override { std::memcpy(&data_[i], in, sizeof(T)); }
+  void permute(const std::vector<std::size_t>& order) override {
+    std::vector<T> out(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) out[k] = data_[order[k]];
+    data_.swap(out);
+  }
+
+  T& operator[](std::size_t i) { return data_[i]; }
+  const T& operator[](std::size_t i) const { return data_[i]; }
+  T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
+  std::size_t size() const { return data_.size(); }
+  const std::vector<T>& vector() const { return data_; }
+
+ private:
+  std::vector<T> data_;
+};
+
+class ParticleStore {
+  // Declared first: the fields below register themselves in it as they are constructed.
+  std::vector<FieldBase*> registry_;
+
+ public:
+  ParticleStore() = default;
+  ParticleStore(const ParticleStore&) = delete;
+  ParticleStore& operator=(const ParticleStore&) = delete;
+
+  // Identity and material.
+  Field<std::int64_t> id{"id", registry_};
+  Field<std::int32_t> material{"material", registry_};
+  // Kinematics: position, velocity, acceleration (translational), angle, spin, angular acc.
+  Field<Vec2> pos{"position", registry_};
+  Field<Vec2> vel{"velocity", registry_};
+  Field<Vec2> acc{"acceleration", registry_};
+  Field<double> theta{"angle", registry_};
+  Field<double> omega{"spin", registry_};
+  Field<double> alpha{"angular_acceleration", registry_};
+  // Shape and inertia (derived from radius and material density when a particle is added).
+  Field<double> radius{"radius", registry_};
+  Field<double> mass{"mass", registry_};
+  Field<double> inv_mass{"inv_mass", registry_};
+  Field<double> inv_inertia{"inv_inertia", registry_};
+  // Force and torque accumulators of the current force evaluation (not state).
+  Field<Vec2> force{"force", registry_};
+  Field<double> torque{"torque", registry_};
+
+  std::size_t size() const { return id.size(); }
+  std::size_t n_owned() const { return n_owned_; }
+  std::size_t n_ghost() const { return size() - n_owned_; }
+  const std::vector<FieldBase*>& fields() const { return registry_; }
+  std::size_t bytes_per_particle() const;
+
+  // Append an owned particle (no ghosts may be present). Returns its index.
+  std::size_t add(std::int64_t pid, std::int32_t mat, double r, double density, Vec2 x, Vec2 v,
+                  double spin);
+  // Remove the owned particles whose flag is set, keeping the order of the rest.
+  void remove_if(const std::vector<char>& remove);
+  // Reorder owned particles: new[k] = old[order[k]].
+  void permute(const std::vector<std::size_t>& order);
+  // Ghost management (parallel layer): drop all ghosts / append n ghost slots.
+  void clear_ghosts();
+  std::size_t add_ghosts(std::size_t n);
+
+  // Derived quantities of one particle.
+  static double sphere_mass(double r, double density);
+  static double sphere_inertia(double m, double r) { return 0.4 * m * r * r; }
+
+ private:
+  void resize_all(std::size_t n);
+  std::size_t n_owned_ = 0;
+};
+
+}  // namespace dem2d

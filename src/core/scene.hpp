@@ -1,0 +1,150 @@
+// Scene: the complete, validated description of one run, as plain data.
+//
+// The deck parser (src/io/deck.*) fills a Scene from a TOML `.in` file and checks every
+// value; the core builds the particle system and the simulation from it and never reads a
+// file. Every field below has the default that the deck documents (docs/input.md); units are
+// SI, angles the parser has already converted to radians.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/vec2.hpp"
+
+namespace dem2d {
+
+enum class ContactModelKind { kHertzMindlin, kThesis, kLinear };
+enum class RollingModelKind { kNone, kConstant, kEpsd };
+enum class IntegratorKind { kVerlet, kIterative };
+
+struct MaterialSpec {
+  std::string name;
+  double density = 0.0;          // kg/m^3
+  double youngs_modulus = 0.0;   // Pa
+  double poisson_ratio = 0.25;   // resolved: the parser derives it from shear_modulus if given
+  double shear_modulus = 0.0;    // Pa, resolved: G = E / (2 (1 + nu)) when not given
+  double restitution = 0.5;      // hertz-mindlin and linear: coefficient of restitution asked
+  double damping_normal = 0.1;   // thesis model: zeta_n (T22)
+  double damping_tangential = 0.1;  // thesis model: zeta_t (T23)
+  double sliding_friction = 0.5;    // mu_s
+  double rolling_friction = 0.0;    // mu_r (dimensionless, times R*)
+  double normal_stiffness = 0.0;    // linear model: k_n in N/m (0: derived from E at 1 % overlap)
+};
+
+// Coefficients for one pair of materials; unset values take the mean of the two materials.
+struct InteractionSpec {
+  std::string material_a;
+  std::string material_b;
+  std::optional<double> restitution;
+  std::optional<double> sliding_friction;
+  std::optional<double> rolling_friction;
+  std::optional<double> damping_normal;
+  std::optional<double> damping_tangential;
+};
+
+struct RunSpec {
+  double duration = 1.0;           // s of simulated time
+  double dt = 0.0;                 // s; 0 means "auto"
+  bool dt_auto = true;
+  IntegratorKind integrator = IntegratorKind::kVerlet;
+  double tolerance = 1.0e-6;       // iterative: relative acceleration change (thesis T31)
+  int max_passes = 20;             // iterative
+  std::uint64_t seed = 1;
+  Vec2 gravity{0.0, -9.81};
+  double skin = -1.0;              // m, Verlet skin; < 0: 0.1 of the smallest diameter... set by core
+  double dt_safety = 0.2;          // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
+  bool allow_unsafe_dt = false;    // run anyway (with a warning) when dt exceeds the safe bound
+};
+
+struct ContactSpec {
+  ContactModelKind model = ContactModelKind::kHertzMindlin;
+  RollingModelKind rolling = RollingModelKind::kEpsd;
+  double rolling_damping = 0.3;    // epsd: eta_r, the rolling dashpot's damping ratio
+};
+
+struct LifterSpec {
+  int count = 0;         // bars evenly spaced around the shell
+  double height = 0.0;   // m, radial
+  double width = 0.0;    // m, along the shell
+  double angle = 0.0;    // rad, angular position of the first bar in the drum frame
+  std::string material;  // empty: the drum's material
+};
+
+struct DrumSpec {
+  bool present = false;
+  double radius = 0.0;
+  Vec2 center{0.0, 0.0};
+  double speed = 0.0;        // rad/s, counter-clockwise positive (resolved from rpm / critical_fraction)
+  double ramp_time = 0.0;    // s to reach the speed (linear ramp from 0)
+  int sides = 0;             // 0: exact circle; N >= 3: regular N-gon with vertices on the circle
+  double angle = 0.0;        // rad, initial drum angle
+  std::string material;
+  std::vector<LifterSpec> lifters;
+};
+
+enum class FillRegion { kBottom, kFull, kBox, kAnnulus };
+
+struct FillSpec {
+  std::string material;
+  // Exactly one source: count, fill_fraction, or file (a CSV packing).
+  std::int64_t count = 0;
+  double fill_fraction = 0.0;  // of the drum's cross-section area (sum of pi r^2)
+  std::string file;            // resolved to an absolute path by the parser
+  double radius_min = 0.0;     // mono-disperse: radius_min == radius_max
+  double radius_max = 0.0;
+  FillRegion region = FillRegion::kBottom;
+  Vec2 box_min{0.0, 0.0};      // region = "box"
+  Vec2 box_max{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};     // initial velocity of every filled particle
+  int source_line = 0;         // deck line, for error messages
+};
+
+struct ParticleSpec {
+  std::string material;
+  double radius = 0.0;
+  Vec2 position{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};
+  double spin = 0.0;  // rad/s, counter-clockwise positive
+  int source_line = 0;
+};
+
+struct WallSpec {
+  Vec2 from{0.0, 0.0};
+  Vec2 to{0.0, 0.0};
+  std::string material;
+  Vec2 velocity{0.0, 0.0};  // a translating wall (moves rigidly)
+};
+
+struct OutputSpec {
+  std::string directory = "out";
+  double series_interval = 1.0e-3;
+  double snapshot_interval = 0.0;    // 0: final state only
+  double checkpoint_interval = 0.0;  // 0: none
+  double progress_interval = 5.0;    // s of wall time between plain progress lines
+};
+
+struct Scene {
+  std::string title;
+  std::string deck_path;  // the deck it came from (for messages and run.json)
+  RunSpec run;
+  ContactSpec contact;
+  std::vector<MaterialSpec> materials;
+  std::vector<InteractionSpec> interactions;
+  DrumSpec drum;
+  std::vector<FillSpec> fills;       // count / fill_fraction fills: the core places them
+  // [[fill]] tables with a `file`, as a record (run.json, the resolved deck): the parser has
+  // already read each CSV into `particles`, after the [[particle]] tables, in this order; here
+  // `count` is the number of rows read and `material` / `velocity` are the defaults for rows
+  // without those columns. The core does not read this.
+  std::vector<FillSpec> file_fills;
+  std::vector<ParticleSpec> particles;
+  std::vector<WallSpec> walls;
+  OutputSpec output;
+};
+
+// Index of a material by name, or -1.
+int find_material(const Scene& scene, const std::string& name);
+
+}  // namespace dem2d

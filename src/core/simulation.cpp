@@ -1,0 +1,530 @@
+#include "core/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "core/contact_models.hpp"
+#include "core/errors.hpp"
+#include "core/fill.hpp"
+
+namespace dem2d {
+
+namespace {
+
+// The pair loop, written once (style.md item 4): particle-particle contacts in canonical
+// (lower id first, sorted) order, then particle-wall contacts. Forces and torques are
+// accumulated into the store; energies and the drive torque into `tot`.
+template <class Model, class Rolling>
+void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
+  ParticleStore& p = sim.particles();
+  const PairTable& table = sim.pair_table();
+  PairList& pl = sim.pair_list();
+  const double eta_r = sim.rolling_damping();
+  const Vec2* x = p.pos.data();
+  const Vec2* v = p.vel.data();
+  const double* w = p.omega.data();
+  const double* r = p.radius.data();
+  const double* m = p.mass.data();
+  const std::int32_t* mat = p.material.data();
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  const std::int32_t* pi = pl.i.data();
+  const std::int32_t* pj = pl.j.data();
+  const ContactHistory* hist = pl.history.data();
+  ContactHistory* trial = pl.trial.data();
+
+  double dissipated = 0.0, elastic = 0.0, max_overlap = 0.0;
+  std::int64_t contacts = 0, worst = -1;
+  const std::size_t n_pairs = pl.size();
+  for (std::size_t k = 0; k < n_pairs; ++k) {
+    const std::int32_t i = pi[k], j = pj[k];
+    const Vec2 d = x[j] - x[i];
+    const double dist2 = norm2(d);
+    const double rsum = r[i] + r[j];
+    if (dist2 >= rsum * rsum) {
+      trial[k] = ContactHistory{};  // no contact: the history ends
+      continue;
+    }
+    const double dist = std::sqrt(dist2);
+    const Vec2 n = (1.0 / dist) * d;
+    const Vec2 t = perp(n);
+    ContactKinematics kin;
+    kin.delta = rsum - dist;
+    kin.r_eff = r[i] * r[j] / rsum;
+    kin.m_eff = m[i] * m[j] / (m[i] + m[j]);
+    if constexpr (Rolling::kNeedsInertia) {
+      // I + m r^2 = 7/5 m r^2 about the contact point; harmonic mean of the two bodies.
+      const double a = 1.4 * m[i] * r[i] * r[i], b = 1.4 * m[j] * r[j] * r[j];
+      kin.i_eff = a * b / (a + b);
+    }
+    const Vec2 vrel = (v[i] - v[j]) + (w[i] * r[i] + w[j] * r[j]) * t;
+    kin.v_n = dot(vrel, n);
+    kin.v_t = dot(vrel, t);
+    kin.omega_rel = w[i] - w[j];
+    const PairCoeffs& c = table(mat[i], mat[j]);
+    const ContactForce cf = Model::evaluate(c, kin, hist[k], trial[k], dt);
+    const Vec2 fi = cf.f_t * t - cf.f_n * n;
+    f[i] += fi;
+    f[j] -= fi;
+    const double arm_i = Model::kTorqueArmIsReff ? kin.r_eff : r[i];
+    const double arm_j = Model::kTorqueArmIsReff ? kin.r_eff : r[j];
+    double ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
+    dissipated += cf.dissipated;
+    elastic += cf.elastic;
+    if constexpr (Rolling::kActive) {
+      const RollingTorque rt = Rolling::evaluate(c, kin, cf.f_n, cf.k_n, hist[k], trial[k], dt, eta_r);
+      ti += rt.torque;
+      tj -= rt.torque;
+      dissipated += rt.dissipated;
+      elastic += rt.elastic;
+    }
+    tq[i] += ti;
+    tq[j] += tj;
+    ++contacts;
+    if (kin.delta > max_overlap * std::min(r[i], r[j])) {
+      max_overlap = kin.delta / std::min(r[i], r[j]);
+      worst = static_cast<std::int64_t>(k);
+    }
+  }
+  if (worst >= 0) {
+    tot.worst_a = p.id[pi[worst]];
+    tot.worst_b = p.id[pj[worst]];
+  }
+
+  // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel.
+  const Walls& walls = sim.walls();
+  WallPairList& wl = sim.wall_pair_list();
+  const int drum = walls.drum_body();
+  const Vec2 drum_center = walls.has_drum() ? walls.bodies()[drum].center : Vec2{};
+  double drum_torque = 0.0, drive_power = 0.0;
+  for (std::size_t k = 0; k < wl.size(); ++k) {
+    const std::int32_t i = wl.particle[k];
+    const WallElement& e = walls.elements()[wl.element[k]];
+    const WallGeometry g = walls.geometry(wl.element[k], x[i], r[i]);
+    if (g.delta <= 0.0) {
+      wl.trial[k] = ContactHistory{};
+      continue;
+    }
+    const WallBody& body = walls.bodies()[e.body];
+    const Vec2 vw = walls.velocity_at(e.body, g.point);
+    const Vec2 n = g.n;
+    const Vec2 t = perp(n);
+    ContactKinematics kin;
+    kin.delta = g.delta;
+    kin.r_eff = r[i];
+    kin.m_eff = m[i];
+    if constexpr (Rolling::kNeedsInertia) kin.i_eff = 1.4 * m[i] * r[i] * r[i];
+    const Vec2 vrel = (v[i] - vw) + (w[i] * r[i]) * t;
+    kin.v_n = dot(vrel, n);
+    kin.v_t = dot(vrel, t);
+    kin.omega_rel = w[i] - body.omega;
+    const PairCoeffs& c = table(mat[i], e.material);
+    const ContactForce cf = Model::evaluate(c, kin, wl.history[k], wl.trial[k], dt);
+    const Vec2 fi = cf.f_t * t - cf.f_n * n;
+    f[i] += fi;
+    double ti = r[i] * cf.f_t;
+    double m_roll = 0.0;
+    dissipated += cf.dissipated;
+    elastic += cf.elastic;
+    if constexpr (Rolling::kActive) {
+      const RollingTorque rt =
+          Rolling::evaluate(c, kin, cf.f_n, cf.k_n, wl.history[k], wl.trial[k], dt, eta_r);
+      m_roll = rt.torque;
+      ti += m_roll;
+      dissipated += rt.dissipated;
+      elastic += rt.elastic;
+    }
+    tq[i] += ti;
+    // Power the wall's drive puts into the particles: F . v_wall + M Omega (the reaction couple).
+    drive_power += dot(fi, vw) + m_roll * body.omega;
+    if (e.body == drum) drum_torque += cross(g.point - drum_center, fi) + m_roll;
+    ++contacts;
+    if (kin.delta / r[i] > max_overlap) {
+      max_overlap = kin.delta / r[i];
+      tot.worst_a = p.id[i];
+      tot.worst_b = -1;
+    }
+  }
+  tot.contacts = contacts;
+  tot.dissipated = dissipated;
+  tot.elastic = elastic;
+  tot.drum_torque = drum_torque;
+  tot.drive_power = drive_power;
+  tot.max_overlap = max_overlap;
+}
+
+template <class Model>
+ForceKernel pick_rolling(RollingModelKind rolling) {
+  switch (rolling) {
+    case RollingModelKind::kNone: return &force_kernel<Model, RollingNone>;
+    case RollingModelKind::kConstant: return &force_kernel<Model, RollingConstant>;
+    case RollingModelKind::kEpsd: return &force_kernel<Model, RollingEpsd>;
+  }
+  return nullptr;
+}
+
+ForceKernel pick_kernel(const ContactSpec& c) {
+  switch (c.model) {
+    case ContactModelKind::kHertzMindlin: return pick_rolling<HertzMindlin>(c.rolling);
+    case ContactModelKind::kThesis: return pick_rolling<ThesisModel>(c.rolling);
+    case ContactModelKind::kLinear: return pick_rolling<LinearModel>(c.rolling);
+  }
+  return nullptr;
+}
+
+std::string format_seconds(double s) {
+  std::ostringstream o;
+  o.precision(3);
+  o << s << " s";
+  return o.str();
+}
+
+}  // namespace
+
+TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
+  TimeScales ts;
+  const double g = norm(scene.run.gravity);
+  // Largest expected impact speed: the drum's rim speed twice (a ball thrown off the shell
+  // meets the shell coming the other way) plus free fall across the drum; without a drum,
+  // the fastest initial particle plus free fall across the particles' extent.
+  double v_max = 0.0, y_lo = std::numeric_limits<double>::max(), y_hi = -y_lo;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    v_max = std::max(v_max, norm(p.vel[k]) + std::abs(p.omega[k]) * p.radius[k]);
+    y_lo = std::min(y_lo, p.pos[k].y - p.radius[k]);
+    y_hi = std::max(y_hi, p.pos[k].y + p.radius[k]);
+  }
+  double fall = p.n_owned() > 0 ? y_hi - y_lo : 0.0;
+  for (const WallSpec& w : scene.walls) {
+    fall = std::max(fall, y_hi - std::min(w.from.y, w.to.y));
+    v_max += norm(w.velocity);
+  }
+  if (scene.drum.present) {
+    fall = 2.0 * scene.drum.radius;
+    v_max = std::max(v_max, 2.0 * std::abs(scene.drum.speed) * scene.drum.radius);
+  }
+  ts.impact_speed = std::max(v_max + std::sqrt(2.0 * g * std::max(fall, 0.0)), 1e-3);
+
+  ts.rayleigh = std::numeric_limits<double>::max();
+  ts.hertz = std::numeric_limits<double>::max();
+  const PairTable table(scene);
+  // Per material: the smallest radius and mass present.
+  const std::size_t nm = scene.materials.size();
+  std::vector<double> r_min(nm, std::numeric_limits<double>::max());
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    r_min[p.material[k]] = std::min(r_min[p.material[k]], p.radius[k]);
+  for (std::size_t a = 0; a < nm; ++a) {
+    if (r_min[a] == std::numeric_limits<double>::max()) continue;
+    const MaterialSpec& m = scene.materials[a];
+    ts.rayleigh = std::min(ts.rayleigh, std::numbers::pi * r_min[a] * std::sqrt(m.density / m.shear_modulus) /
+                                             (0.1631 * m.poisson_ratio + 0.8766));
+    // Hertz contact time of the smallest sphere against a wall of the stiffest material
+    // (m* = m, R* = r): t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5).
+    for (std::size_t b = 0; b < nm; ++b) {
+      const double mass = ParticleStore::sphere_mass(r_min[a], m.density);
+      const double e_star = table(static_cast<int>(a), static_cast<int>(b)).e_star;
+      const double tc = 2.868 * std::pow(mass * mass / (r_min[a] * e_star * e_star * ts.impact_speed), 0.2);
+      ts.hertz = std::min(ts.hertz, tc);
+    }
+  }
+  if (ts.rayleigh == std::numeric_limits<double>::max()) ts.rayleigh = ts.hertz = 1.0;
+  const double bound = std::min(ts.rayleigh, ts.hertz);
+  ts.safe_dt = scene.run.dt_safety * bound;
+  ts.limit_dt = 0.5 * bound;
+  return ts;
+}
+
+Simulation::Simulation(const Scene& scene, Domain* domain)
+    : scene_(scene), domain_(domain ? domain : &serial_domain_), walls_(scene_),
+      pair_table_(scene_) {
+  kernel_ = pick_kernel(scene_.contact);
+  gravity_ = scene_.run.gravity;
+  place_particles(scene_, walls_, particles_);
+  scales_ = time_scales(scene_, particles_);
+  if (scene_.run.dt_auto || scene_.run.dt <= 0.0) {
+    dt_ = scales_.safe_dt;
+  } else {
+    dt_ = scene_.run.dt;
+    if (dt_ > scales_.limit_dt && !scene_.run.allow_unsafe_dt) {
+      std::ostringstream o;
+      o << scene_.deck_path << ": error: run.dt = " << dt_ << " s is unsafe: it exceeds half of "
+        << "the smallest Rayleigh time (" << format_seconds(scales_.rayleigh) << ") or Hertz contact time ("
+        << format_seconds(scales_.hertz) << " at " << scales_.impact_speed << " m/s); the safe dt is "
+        << scales_.safe_dt << " s (dt = \"auto\"); set run.allow_unsafe_dt = true to run anyway";
+      throw InputError(o.str());
+    }
+  }
+  double r_min = std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < particles_.size(); ++k) r_min = std::min(r_min, particles_.radius[k]);
+  skin_ = scene_.run.skin >= 0.0 ? scene_.run.skin : (particles_.size() ? 0.4 * r_min : 0.0);
+  rebuild();
+  refresh_forces();
+  save_backup();
+}
+
+void Simulation::rebuild() {
+  search_.build(particles_, walls_, skin_, pairs_, wall_pairs_);
+  pos_at_build_.assign(particles_.pos.data(), particles_.pos.data() + particles_.n_owned());
+  drum_angle_at_build_ = walls_.drum_angle();
+  time_at_build_ = time_;
+  max_disp2_ = 0.0;
+}
+
+bool Simulation::rebuild_needed() const {
+  // Two particles approach by at most twice the largest displacement; a wall moves at most
+  // rotating_reach * |drum angle change| + translation speed * elapsed time.
+  const double wall_move = walls_.rotating_reach() * std::abs(walls_.drum_angle() - drum_angle_at_build_) +
+                           walls_.max_translation_speed() * (time_ - time_at_build_);
+  const double disp = std::sqrt(max_disp2_);
+  return domain_->any(2.0 * disp + wall_move >= skin_);
+}
+
+void Simulation::refresh_forces() {
+  evaluate_forces(0.0);
+  pairs_.history = pairs_.trial;
+  wall_pairs_.history = wall_pairs_.trial;
+}
+
+void Simulation::evaluate_forces(double dt_history) {
+  ParticleStore& p = particles_;
+  const std::size_t n = p.size();
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  for (std::size_t k = 0; k < n; ++k) {
+    f[k] = {};
+    tq[k] = 0.0;
+  }
+  totals_ = EvaluationTotals{};
+  kernel_(*this, dt_history, totals_);
+  // Accelerations; gravity added last, the same way for every particle.
+  const std::size_t n_owned = p.n_owned();
+  Vec2* a = p.acc.data();
+  double* al = p.alpha.data();
+  const double* inv_m = p.inv_mass.data();
+  const double* inv_i = p.inv_inertia.data();
+  double checksum = 0.0;
+  for (std::size_t k = 0; k < n_owned; ++k) {
+    a[k] = inv_m[k] * f[k] + gravity_;
+    al[k] = inv_i[k] * tq[k];
+    checksum += std::abs(a[k].x) + std::abs(a[k].y) + std::abs(al[k]);
+  }
+  accel_checksum_ = checksum;
+}
+
+void Simulation::commit_history() {
+  pairs_.history.swap(pairs_.trial);
+  wall_pairs_.history.swap(wall_pairs_.trial);
+}
+
+void Simulation::account(const EvaluationTotals& t, double dt) {
+  dissipated_ += t.dissipated;
+  drive_work_ += t.drive_power * dt;
+}
+
+void Simulation::step() {
+  if (scene_.run.integrator == IntegratorKind::kVerlet)
+    step_verlet();
+  else
+    step_iterative();
+  ++step_;
+  check_stability();
+  if (step_ % 1000 == 0) save_backup();
+}
+
+void Simulation::run_until(double t_end) {
+  while (time_ + 0.5 * dt_ < t_end) step();
+}
+
+// Velocity Verlet (kick-drift-kick); the velocity-dependent forces see the half-step velocity.
+void Simulation::step_verlet() {
+  ParticleStore& p = particles_;
+  const std::size_t n = p.n_owned();
+  const double h = 0.5 * dt_;
+  Vec2* x = p.pos.data();
+  Vec2* v = p.vel.data();
+  const Vec2* a = p.acc.data();
+  double* th = p.theta.data();
+  double* w = p.omega.data();
+  const double* al = p.alpha.data();
+  const Vec2* xb = pos_at_build_.data();
+  double disp2 = max_disp2_;
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] += h * a[k];
+    w[k] += h * al[k];
+    x[k] += dt_ * v[k];
+    th[k] += dt_ * w[k];
+    disp2 = std::max(disp2, norm2(x[k] - xb[k]));
+  }
+  max_disp2_ = disp2;
+  time_ = static_cast<double>(step_ + 1) * dt_;
+  walls_.update(time_);
+  if (rebuild_needed()) rebuild();
+  evaluate_forces(dt_);
+  for (std::size_t k = 0; k < n; ++k) {
+    v[k] += h * a[k];
+    w[k] += h * al[k];
+  }
+  commit_history();
+  account(totals_, dt_);
+  last_passes_ = 1;
+  passes_total_ += 1;
+  passes_since_row_ += 1;
+  steps_since_row_ += 1;
+}
+
+// The thesis's iterative refinement (T3-T8, T26-T33): predict the state at t + dt with the
+// jerk b = (a1 - a0)/dt, re-evaluate forces there, repeat until the accelerations stop
+// changing. Converged, this is Newmark's linear-acceleration method:
+//   x1 = x0 + v0 dt + (2 a0 + a1) dt^2 / 6,  v1 = v0 + (a0 + a1) dt / 2.
+void Simulation::step_iterative() {
+  ParticleStore& p = particles_;
+  const std::size_t n = p.n_owned();
+  x0_.assign(p.pos.data(), p.pos.data() + n);
+  v0_.assign(p.vel.data(), p.vel.data() + n);
+  a0_.assign(p.acc.data(), p.acc.data() + n);
+  th0_.assign(p.theta.data(), p.theta.data() + n);
+  w0_.assign(p.omega.data(), p.omega.data() + n);
+  al0_.assign(p.alpha.data(), p.alpha.data() + n);
+  std::vector<Vec2> a1(a0_);
+  std::vector<double> al1(al0_);
+  const double dt = dt_, c2 = dt * dt / 6.0;
+  const double eps = scene_.run.tolerance;
+  const double a_ref = std::max(norm(gravity_), 1e-12);
+  time_ = static_cast<double>(step_ + 1) * dt_;
+  walls_.update(time_);
+
+  auto predict = [&]() {
+    Vec2* x = p.pos.data();
+    Vec2* v = p.vel.data();
+    double* th = p.theta.data();
+    double* w = p.omega.data();
+    for (std::size_t k = 0; k < n; ++k) {
+      x[k] = x0_[k] + dt * v0_[k] + c2 * (2.0 * a0_[k] + a1[k]);
+      v[k] = v0_[k] + (0.5 * dt) * (a0_[k] + a1[k]);
+      th[k] = th0_[k] + dt * w0_[k] + c2 * (2.0 * al0_[k] + al1[k]);
+      w[k] = w0_[k] + (0.5 * dt) * (al0_[k] + al1[k]);
+    }
+  };
+
+  int pass = 0;
+  bool converged = false;
+  const int max_passes = std::max(1, scene_.run.max_passes);
+  while (pass < max_passes && !converged) {
+    predict();
+    if (pass == 0) {
+      double disp2 = max_disp2_;
+      for (std::size_t k = 0; k < n; ++k) disp2 = std::max(disp2, norm2(p.pos[k] - pos_at_build_[k]));
+      max_disp2_ = disp2;
+      if (rebuild_needed()) rebuild();
+    }
+    evaluate_forces(dt);
+    ++pass;
+    // Converged when |a^k - a^(k-1)| <= eps (|a^k| + a_ref) for every DOF (T31); angular
+    // accelerations are compared in units of a_ref / r.
+    bool ok = true;
+    for (std::size_t k = 0; k < n && ok; ++k) {
+      const Vec2 a = p.acc[k];
+      const double scale_w = 1.0 / p.radius[k];
+      ok = std::abs(a.x - a1[k].x) <= eps * (std::abs(a.x) + a_ref) &&
+           std::abs(a.y - a1[k].y) <= eps * (std::abs(a.y) + a_ref) &&
+           std::abs(p.alpha[k] - al1[k]) <= eps * (std::abs(p.alpha[k]) + a_ref * scale_w);
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+      a1[k] = p.acc[k];
+      al1[k] = p.alpha[k];
+    }
+    converged = ok && pass > 1;
+  }
+  // Final state from the last accelerations (p.acc already holds a1 for the next step).
+  predict();
+  if (!converged) ++unconverged_steps_;
+  double disp2 = max_disp2_;
+  for (std::size_t k = 0; k < n; ++k) disp2 = std::max(disp2, norm2(p.pos[k] - pos_at_build_[k]));
+  max_disp2_ = disp2;
+  commit_history();
+  account(totals_, dt);
+  last_passes_ = pass;
+  passes_total_ += pass;
+  passes_since_row_ += pass;
+  steps_since_row_ += 1;
+}
+
+void Simulation::check_stability() {
+  const double max_overlap = domain_->max(totals_.max_overlap);
+  const bool finite = std::isfinite(domain_->sum(accel_checksum_));
+  constexpr double kMaxOverlap = 0.25;  // of the smaller radius
+  if (finite && max_overlap <= kMaxOverlap) return;
+  std::ostringstream o;
+  o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
+  if (!finite) {
+    o << "non-finite accelerations";
+  } else {
+    o << "overlap " << max_overlap << " of a radius between particle " << totals_.worst_a;
+    if (totals_.worst_b >= 0)
+      o << " and particle " << totals_.worst_b;
+    else
+      o << " and a wall";
+  }
+  o << "; dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt << " s";
+  if (!finite) {
+    restore_backup();
+    o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
+  }
+  throw UnstableError(o.str(), step_, time_);
+}
+
+void Simulation::save_backup() {
+  const std::size_t n = particles_.n_owned();
+  backup_pos_.assign(particles_.pos.data(), particles_.pos.data() + n);
+  backup_vel_.assign(particles_.vel.data(), particles_.vel.data() + n);
+  backup_theta_.assign(particles_.theta.data(), particles_.theta.data() + n);
+  backup_omega_.assign(particles_.omega.data(), particles_.omega.data() + n);
+  backup_time_ = time_;
+  backup_step_ = step_;
+}
+
+void Simulation::restore_backup() {
+  const std::size_t n = particles_.n_owned();
+  if (backup_pos_.size() != n) return;
+  std::copy(backup_pos_.begin(), backup_pos_.end(), particles_.pos.data());
+  std::copy(backup_vel_.begin(), backup_vel_.end(), particles_.vel.data());
+  std::copy(backup_theta_.begin(), backup_theta_.end(), particles_.theta.data());
+  std::copy(backup_omega_.begin(), backup_omega_.end(), particles_.omega.data());
+  time_ = backup_time_;
+  step_ = backup_step_;
+}
+
+SeriesRow Simulation::diagnostics() const {
+  const ParticleStore& p = particles_;
+  SeriesRow row;
+  row.time = time_;
+  row.step = step_;
+  double ke = 0.0, re = 0.0, pe = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    ke += 0.5 * p.mass[k] * norm2(p.vel[k]);
+    re += 0.5 * p.mass[k] * 0.4 * p.radius[k] * p.radius[k] * p.omega[k] * p.omega[k];
+    pe -= p.mass[k] * dot(gravity_, p.pos[k]);
+  }
+  row.particles = domain_->sum(static_cast<std::int64_t>(p.n_owned()));
+  row.contacts = domain_->sum(totals_.contacts);
+  row.kinetic_energy = domain_->sum(ke);
+  row.rotational_energy = domain_->sum(re);
+  row.potential_energy = domain_->sum(pe);
+  row.elastic_energy = domain_->sum(totals_.elastic);
+  row.dissipated_energy = domain_->sum(dissipated_);
+  row.drum_torque = domain_->sum(totals_.drum_torque);
+  row.drum_power = row.drum_torque * walls_.drum_omega();
+  row.drive_work = domain_->sum(drive_work_);
+  row.passes = steps_since_row_ > 0 ? static_cast<double>(passes_since_row_) / steps_since_row_
+                                    : static_cast<double>(last_passes_);
+  return row;
+}
+
+void Simulation::reset_pass_window() {
+  passes_since_row_ = 0;
+  steps_since_row_ = 0;
+}
+
+}  // namespace dem2d

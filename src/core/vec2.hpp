@@ -1,0 +1,35 @@
+// Vec2: a 2D vector of doubles with the handful of operations the physics needs.
+// The scalar cross product cross(a, b) = a_x b_y - a_y b_x is the z component of a x b;
+// perp(a) = z x a = (-a_y, a_x) turns a vector 90 degrees counter-clockwise.
+#pragma once
+
+#include <cmath>
+
+namespace dem2d {
+
+struct Vec2 {
+  double x = 0.0;
+  double y = 0.0;
+
+  constexpr Vec2& operator+=(Vec2 b) { x += b.x; y += b.y; return *this; }
+  constexpr Vec2& operator-=(Vec2 b) { x -= b.x; y -= b.y; return *this; }
+  constexpr Vec2& operator*=(double s) { x *= s; y *= s; return *this; }
+};
+
+constexpr Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }
+constexpr Vec2 operator-(Vec2 a, Vec2 b) { return {a.x - b.x, a.y - b.y}; }
+constexpr Vec2 operator-(Vec2 a) { return {-a.x, -a.y}; }
+constexpr Vec2 operator*(double s, Vec2 a) { return {s * a.x, s * a.y}; }
+constexpr Vec2 operator*(Vec2 a, double s) { return {s * a.x, s * a.y}; }
+constexpr bool operator==(Vec2 a, Vec2 b) { return a.x == b.x && a.y == b.y; }
+constexpr double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+constexpr Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
+constexpr double norm2(Vec2 a) { return dot(a, a); }
+inline double norm(Vec2 a) { return std::sqrt(norm2(a)); }
+inline Vec2 rotate(Vec2 a, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return {c * a.x - s * a.y, s * a.x + c * a.y};
+}
+
+}  // namespace dem2d

@@ -1,0 +1,84 @@
+// Walls: rigid bodies with a prescribed motion, made of elements a sphere can touch.
+//
+// Bodies: the drum (rotating about its centre at Omega(t), linear ramp from 0 over ramp_time)
+// and each [[wall]] segment (static or translating). Elements: the drum's exact inner circle,
+// or the N sides of its regular polygon (vertices on the circle of the drum's radius, thesis
+// T 1.6), the three exposed sides of each rectangular lifter (seed 003), and straight segments.
+// Elements of the drum are stored in the drum frame and placed in the lab frame by `update`.
+//
+// Contact with a wall element (physics.md section 2): R* = r_i, m* = m_i, the wall's velocity
+// at the contact point p is u_body + Omega_body z x (p - c_body), w_rel = w_i - Omega_body.
+#pragma once
+
+#include <vector>
+
+#include "core/scene.hpp"
+#include "core/vec2.hpp"
+
+namespace dem2d {
+
+struct WallBody {
+  Vec2 center{};         // rotation centre (drum) or reference point (translating wall)
+  double speed = 0.0;    // rad/s at full speed (drum)
+  double ramp_time = 0.0;
+  double angle0 = 0.0;   // rad, angle at t = 0
+  Vec2 velocity{};       // m/s, translation (walls)
+  // State at the current time (set by Walls::update).
+  double omega = 0.0;
+  double angle = 0.0;
+  Vec2 offset{};         // translation since t = 0
+};
+
+enum class WallKind { kCircle, kSegment };
+
+struct WallElement {
+  WallKind kind = WallKind::kSegment;
+  int body = 0;
+  int material = 0;
+  double radius = 0.0;  // circle
+  Vec2 a_ref{}, b_ref{};  // segment ends in the body frame (relative to the body's centre)
+  Vec2 a{}, b{};          // segment ends in the lab frame at the current time
+};
+
+// Closest contact of a sphere (centre x, radius r) with one element at the current time.
+struct WallGeometry {
+  double delta = 0.0;  // overlap (> 0 in contact); for the reach test: r - distance to surface
+  Vec2 n{};            // unit normal from the sphere's centre towards the wall
+  Vec2 point{};        // contact point on the wall
+};
+
+class Walls {
+ public:
+  Walls() = default;
+  Walls(const Scene& scene);  // materials resolved by name through `scene`
+
+  void update(double time);  // body states and element lab positions at `time`
+  WallGeometry geometry(int element, Vec2 x, double r) const;
+  Vec2 velocity_at(int body, Vec2 p) const {
+    const WallBody& b = bodies_[body];
+    return b.velocity + b.omega * perp(p - (b.center + b.offset));
+  }
+  // Largest distance any rotating element point moves per unit drum angle (m/rad): bounds the
+  // wall motion between neighbour-list rebuilds. 0 when nothing but circles rotates.
+  double rotating_reach() const { return rotating_reach_; }
+  double max_translation_speed() const;
+
+  const std::vector<WallBody>& bodies() const { return bodies_; }
+  const std::vector<WallElement>& elements() const { return elements_; }
+  bool has_drum() const { return drum_body_ >= 0; }
+  int drum_body() const { return drum_body_; }
+  double drum_angle() const { return has_drum() ? bodies_[drum_body_].angle : 0.0; }
+  double drum_omega() const { return has_drum() ? bodies_[drum_body_].omega : 0.0; }
+
+ private:
+  std::vector<WallBody> bodies_;
+  std::vector<WallElement> elements_;
+  int drum_body_ = -1;
+  double rotating_reach_ = 0.0;
+};
+
+// Drum speed and angle at time t for a linear ramp from 0 to `speed` over `ramp` seconds.
+double ramp_speed(double speed, double ramp, double t);
+double ramp_angle(double speed, double ramp, double t);
+
+}  // namespace dem2d
