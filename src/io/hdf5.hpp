@@ -1,0 +1,135 @@
+// All of dem2d's HDF5 code: RAII handles and a parallel file that writes row-distributed
+// datasets collectively.
+//
+// Every HDF5 call is checked; a failure throws IoError naming the file, the operation and
+// the object, followed by the innermost messages of HDF5's error stack (HDF5's own printing
+// of that stack to stderr is switched off the first time a file is opened here).
+//
+// Parallel model. A file is opened with the MPI-IO driver (H5Pset_fapl_mpio) on a
+// communicator, also on one rank. Every ParallelFile member is collective: all ranks of the
+// communicator call it, in the same order, with the same names and the same attribute
+// values. A row-distributed dataset has `total` rows of `columns` values; rank r writes its
+// `count` rows at row `offset`, where the offsets come from MPI_Exscan of the counts
+// (row_range), so rank 0's rows come first, then rank 1's, and so on. The data transfer is
+// collective (H5FD_MPIO_COLLECTIVE); a rank with no rows takes part with an empty selection.
+#pragma once
+
+#include <hdf5.h>
+#include <mpi.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace dem2d::h5 {
+
+// Owns one HDF5 identifier and closes it with the matching H5?close function. close()
+// reports the status (for the normal path, where it is checked); the destructor ignores it.
+template <herr_t (*Close)(hid_t)>
+class Handle {
+ public:
+  Handle() = default;
+  explicit Handle(hid_t id) : id_(id) {}
+  ~Handle() { close(); }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& other) noexcept : id_(std::exchange(other.id_, H5I_INVALID_HID)) {}
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) {
+      close();
+      id_ = std::exchange(other.id_, H5I_INVALID_HID);
+    }
+    return *this;
+  }
+
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  // Closes the identifier (if any); returns the close function's status, 0 if none was open.
+  herr_t close() noexcept { return valid() ? Close(std::exchange(id_, H5I_INVALID_HID)) : 0; }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+};
+
+using FileHandle = Handle<H5Fclose>;
+using GroupHandle = Handle<H5Gclose>;
+using DatasetHandle = Handle<H5Dclose>;
+using DataspaceHandle = Handle<H5Sclose>;
+using PropListHandle = Handle<H5Pclose>;
+using AttributeHandle = Handle<H5Aclose>;
+using DatatypeHandle = Handle<H5Tclose>;
+
+// The rows one rank contributes to a row-distributed dataset.
+struct RowRange {
+  std::uint64_t offset = 0;  // first global row of this rank: MPI_Exscan of the counts
+  std::uint64_t count = 0;   // rows this rank writes
+  std::uint64_t total = 0;   // rows of all ranks: MPI_Allreduce of the counts
+};
+
+// Collective: the range of `local_count` rows on this rank, in rank order.
+RowRange row_range(MPI_Comm comm, std::size_t local_count);
+
+// The same range on every rank for data that rank 0 alone writes (a small table).
+RowRange rank0_rows(MPI_Comm comm, std::size_t count);
+
+class ParallelFile {
+ public:
+  // Collective: creates `path` (truncating an existing file) with the MPI-IO driver.
+  // Throws IoError "cannot create PATH: REASON" on failure (on the failing ranks; callers
+  // that need agreement wrap it, see SnapshotWriter).
+  static ParallelFile create(MPI_Comm comm, const std::string& path);
+
+  ParallelFile(ParallelFile&&) noexcept = default;
+  ParallelFile& operator=(ParallelFile&&) noexcept = default;
+  ~ParallelFile() = default;  // closes the file, ignoring errors
+
+  const std::string& path() const { return path_; }
+  MPI_Comm comm() const { return comm_; }
+
+  // Creates the group at the absolute path `name`, with any missing parents.
+  void create_group(const std::string& name);
+
+  // Scalar attribute `attribute` on the object at `object` (an absolute path).
+  void write_attribute(const std::string& object, const std::string& attribute, double value);
+  void write_attribute(const std::string& object, const std::string& attribute, std::int64_t value);
+
+  // Creates the dataset `name` (absolute path) with range.total rows of `columns` values
+  // (rank 1 when columns == 1, else rank 2) and writes this rank's range.count rows from
+  // `data` (row-major, range.count * columns values) collectively. `data` may be null when
+  // range.count is 0.
+  void write_rows(const std::string& name, const RowRange& range, const double* data,
+                  std::size_t columns = 1);
+  void write_rows(const std::string& name, const RowRange& range, const std::int64_t* data,
+                  std::size_t columns = 1);
+  void write_rows(const std::string& name, const RowRange& range, const std::int32_t* data,
+                  std::size_t columns = 1);
+  // A 1-D dataset of fixed-length, null-terminated strings; `values` must be the same on all
+  // ranks (rank 0's are written).
+  void write_strings(const std::string& name, const std::vector<std::string>& values);
+
+  // Collective: pushes everything written so far to the file (H5Fflush, global scope).
+  void flush();
+  // Collective: closes the file, checking the result. Later calls do nothing.
+  void close();
+
+ private:
+  ParallelFile(MPI_Comm comm, std::string path) : comm_(comm), path_(std::move(path)) {}
+  void write_scalar_attribute(const std::string& object, const std::string& attribute,
+                              hid_t file_type, hid_t memory_type, const void* value);
+  void write_rows_typed(const std::string& name, const RowRange& range, hid_t file_type,
+                        hid_t memory_type, const void* data, std::size_t columns);
+  [[noreturn]] void fail(const std::string& operation, const std::string& object) const;
+  template <class Id>
+  Id check(Id status, const std::string& operation, const std::string& object) const {
+    if (status < 0) fail(operation, object);
+    return status;
+  }
+
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  std::string path_;
+  FileHandle file_;
+};
+
+}  // namespace dem2d::h5

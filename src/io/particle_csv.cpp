@@ -1,0 +1,187 @@
+#include "io/particle_csv.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <optional>
+
+#include "io/deck_schema.hpp"
+#include "io/text.hpp"
+
+namespace dem2d {
+namespace {
+
+enum Column { kX, kY, kRadius, kVx, kVy, kSpin, kMaterial, kColumns };  // as deck::kCsvColumns
+
+// The field index of each column, -1 where the file has none.
+using ColumnIndex = std::array<int, kColumns>;
+
+// Collects the messages about one file, and stops keeping them after kMaxCsvErrors.
+class CsvErrors {
+ public:
+  CsvErrors(const std::string& shown, std::vector<std::string>& out) : shown_(shown), out_(out) {}
+  void at(int line, std::string_view message) {
+    if (++count_ <= kMaxCsvErrors) {
+      out_.push_back(line > 0 ? fmt::format("{}:{}: error: {}", shown_, line, message)
+                              : fmt::format("{}: error: {}", shown_, message));
+    }
+  }
+  void finish() {
+    if (count_ > kMaxCsvErrors) {
+      out_.push_back(fmt::format("{}: error: {} more errors in this file not shown", shown_,
+                                 count_ - kMaxCsvErrors));
+    }
+  }
+  int count() const { return count_; }
+
+ private:
+  const std::string& shown_;
+  std::vector<std::string>& out_;
+  int count_ = 0;
+};
+
+std::vector<std::string_view> split_fields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  for (std::size_t start = 0;;) {
+    const std::size_t comma = line.find(',', start);
+    std::string_view field = trim(line.substr(start, comma - start));
+    if (field.size() >= 2 && field.front() == '"' && field.back() == '"') {
+      field = field.substr(1, field.size() - 2);
+    }
+    fields.push_back(field);
+    if (comma == std::string_view::npos) return fields;
+    start = comma + 1;
+  }
+}
+
+// The header row: which field holds each column. Reports unknown, repeated and missing ones.
+ColumnIndex read_header(const std::vector<std::string_view>& fields, int line, CsvErrors& errors) {
+  ColumnIndex index;
+  index.fill(-1);
+  std::vector<std::string_view> suggested;  // a misspelt column is not also "missing"
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string name = lowercase(fields[i]);
+    const auto known = std::find(deck::kCsvColumns.begin(), deck::kCsvColumns.end(), name);
+    if (known == deck::kCsvColumns.end()) {
+      std::string message = fmt::format("unknown column '{}'", fields[i]);
+      if (const auto near = closest_match(name, deck::kCsvColumns)) {
+        message += fmt::format("; did you mean '{}'?", *near);
+        suggested.push_back(*near);
+      }
+      errors.at(line, message + " (columns: " + comma_list(deck::kCsvColumns) + ")");
+    } else if (int& slot = index[known - deck::kCsvColumns.begin()]; slot >= 0) {
+      errors.at(line, fmt::format("column '{}' appears twice", name));
+    } else {
+      slot = static_cast<int>(i);
+    }
+  }
+  for (const Column required : {kX, kY, kRadius}) {
+    const std::string_view name = deck::kCsvColumns[required];
+    if (index[required] < 0 &&
+        std::find(suggested.begin(), suggested.end(), name) == suggested.end()) {
+      errors.at(line, fmt::format("missing column '{}' (the header names x, y, radius and "
+                                  "optionally vx, vy, spin, material)",
+                                  name));
+    }
+  }
+  return index;
+}
+
+// One data row as a particle, or nullopt after reporting what is wrong with it.
+std::optional<ParticleSpec> read_row(const std::vector<std::string_view>& fields,
+                                     const ColumnIndex& index, int line,
+                                     const std::vector<std::string>& material_names,
+                                     const CsvDefaults& defaults, CsvErrors& errors) {
+  bool ok = true;
+  const auto number = [&](Column column, double fallback) {
+    if (index[column] < 0) return fallback;
+    const std::string_view field = fields[static_cast<std::size_t>(index[column])];
+    const std::string_view digits = field.starts_with('+') ? field.substr(1) : field;
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+    if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() ||
+        !std::isfinite(value)) {
+      errors.at(line, fmt::format("column '{}' = {}: expected a number", deck::kCsvColumns[column],
+                                  quoted_string(field)));
+      ok = false;
+    }
+    return value;
+  };
+  ParticleSpec p;
+  p.source_line = line;
+  p.position = {number(kX, 0.0), number(kY, 0.0)};
+  p.radius = number(kRadius, 0.0);
+  p.velocity = {number(kVx, defaults.velocity.x), number(kVy, defaults.velocity.y)};
+  p.spin = number(kSpin, 0.0);
+  if (ok && p.radius <= 0.0) {
+    errors.at(line, fmt::format("column 'radius' = {}: must be > 0", p.radius));
+    ok = false;
+  }
+  const std::string_view material =
+      index[kMaterial] >= 0 ? fields[static_cast<std::size_t>(index[kMaterial])] : "";
+  p.material = material.empty() ? defaults.material : std::string(material);
+  if (p.material.empty()) {
+    errors.at(line, "no material: the material field is empty and the [[fill]] gives none");
+    ok = false;
+  } else if (!material.empty() && std::find(material_names.begin(), material_names.end(),
+                                            p.material) == material_names.end()) {
+    std::string message =
+        fmt::format("column 'material' = {}: no such material", quoted_string(p.material));
+    if (const auto near = closest_match(p.material, material_names)) {
+      message += fmt::format("; did you mean {}?", quoted_string(*near));
+    }
+    errors.at(line, message + fmt::format(" (defined: {})", quoted_list(material_names)));
+    ok = false;
+  }
+  if (!ok) return std::nullopt;
+  return p;
+}
+
+}  // namespace
+
+CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
+                             const std::vector<std::string>& material_names,
+                             const CsvDefaults& defaults) {
+  CsvPacking packing;
+  CsvErrors errors(shown, packing.errors);
+  if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte order mark
+  std::optional<ColumnIndex> index;
+  std::size_t n_fields = 0;
+  for (int line = 1; !text.empty(); ++line) {
+    const std::size_t newline = text.find('\n');
+    const std::string_view row = trim(text.substr(0, newline));
+    text.remove_prefix(newline == std::string_view::npos ? text.size() : newline + 1);
+    if (row.empty() || row.front() == '#') continue;
+    const std::vector<std::string_view> fields = split_fields(row);
+    if (!index) {
+      index = read_header(fields, line, errors);
+      n_fields = fields.size();
+      packing.has_material_column = (*index)[kMaterial] >= 0;
+      const bool materials_known = packing.has_material_column || !defaults.material.empty();
+      if (errors.count() > 0 || !materials_known) break;  // the rows cannot be read
+      continue;
+    }
+    if (fields.size() != n_fields) {
+      errors.at(line,
+                fmt::format("{} fields, expected {} as in the header", fields.size(), n_fields));
+      continue;
+    }
+    if (auto p = read_row(fields, *index, line, material_names, defaults, errors)) {
+      packing.particles.push_back(std::move(*p));
+    }
+  }
+  if (!index) {
+    errors.at(0, "empty file: expected a header row naming x, y, radius");
+  } else if (packing.particles.empty() && errors.count() == 0 &&
+             (packing.has_material_column || !defaults.material.empty())) {
+    errors.at(0, "no particles: the file has a header row but no rows");
+  }
+  errors.finish();
+  if (errors.count() > 0) packing.particles.clear();
+  return packing;
+}
+
+}  // namespace dem2d

@@ -1,0 +1,40 @@
+// Particle packings read from CSV files (a [[fill]] with `file`, docs/input.md).
+//
+// Format: a header row naming the columns, in any order and any case: x, y, radius (m,
+// required), vx, vy (m/s), spin (rad/s), material (a [[material]] name) optional; then one
+// particle per row. Fields are separated by commas; a field may be wrapped in double quotes;
+// blank lines and lines starting with '#' are skipped.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/scene.hpp"
+
+namespace dem2d {
+
+// Values for the columns a file leaves out (and for an empty material field).
+struct CsvDefaults {
+  std::string material;  // "": every row must name its material
+  Vec2 velocity{0.0, 0.0};
+};
+
+struct CsvPacking {
+  std::vector<ParticleSpec> particles;  // source_line = the line in the file
+  // Complete messages, "FILE:LINE: error: ..." (or "FILE: error: ..."); at most
+  // kMaxCsvErrors of them plus one line counting the rest.
+  std::vector<std::string> errors;
+  bool has_material_column = false;
+};
+
+inline constexpr int kMaxCsvErrors = 20;
+
+// Reads the text of one file; `shown` names it in messages, `material_names` are the deck's.
+// Without a material column and without a default material, no row is read and no row error
+// is given: the caller reports that the fill needs a material.
+CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
+                             const std::vector<std::string>& material_names,
+                             const CsvDefaults& defaults);
+
+}  // namespace dem2d

@@ -1,0 +1,657 @@
+// Output files: snapshots.h5 (+ snapshots.xmf), series.csv and the output directory.
+// Runs on any number of ranks (mpirun -np 1, 2, 3): each rank owns a contiguous block of the
+// particles (or, in one test, none), and the file must hold them in rank order.
+// Set DEM2D_KEEP_TEST_OUTPUT=1 to keep the files (rank 0 prints where they are).
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <mpi.h>
+#include <stdlib.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/particles.hpp"
+#include "core/scene.hpp"
+#include "io/hdf5.hpp"
+#include "io/output_dir.hpp"
+#include "io/series.hpp"
+#include "io/snapshots.hpp"
+
+namespace dem2d {
+namespace {
+
+namespace fs = std::filesystem;
+
+int comm_rank() {
+  int r = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+int comm_size() {
+  int s = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &s);
+  return s;
+}
+
+// Rank 0's copy of `s` on every rank.
+std::string rank0_string(std::string s) {
+  unsigned long n = s.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG, 0, MPI_COMM_WORLD);
+  s.resize(n);
+  MPI_Bcast(s.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+  return s;
+}
+
+// A fresh directory that all ranks share, removed at the end unless DEM2D_KEEP_TEST_OUTPUT.
+class ScratchDir {
+ public:
+  ScratchDir() {
+    std::string path;
+    if (comm_rank() == 0) {
+      std::string pattern = (fs::path(testing::TempDir()) / "dem2d_io_XXXXXX").string();
+      if (::mkdtemp(pattern.data()) == nullptr) std::abort();
+      path = pattern;
+    }
+    path_ = rank0_string(path);
+  }
+  ~ScratchDir() {
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (comm_rank() != 0) return;
+    if (std::getenv("DEM2D_KEEP_TEST_OUTPUT") != nullptr) {
+      std::printf("[ kept     ] %s\n", path_.c_str());
+    } else {
+      std::error_code ec;
+      fs::remove_all(path_, ec);
+    }
+  }
+  const std::string& path() const { return path_; }
+  std::string operator/(const std::string& name) const { return (fs::path(path_) / name).string(); }
+
+ private:
+  std::string path_;
+};
+
+std::vector<MaterialSpec> test_materials() {
+  MaterialSpec steel;
+  steel.name = "steel";
+  steel.density = 7800.0;
+  steel.youngs_modulus = 2.0e11;
+  steel.poisson_ratio = 0.25;
+  steel.shear_modulus = 8.0e10;
+  steel.restitution = 0.73;
+  steel.sliding_friction = 0.1;
+  steel.rolling_friction = 0.05;
+  MaterialSpec ore;
+  ore.name = "iron ore";
+  ore.density = 3500.0;
+  ore.youngs_modulus = 5.0e10;
+  ore.poisson_ratio = 0.3;
+  ore.shear_modulus = 5.0e10 / 2.6;
+  ore.restitution = 0.5;
+  ore.sliding_friction = 0.6;
+  ore.rolling_friction = 0.1;
+  MaterialSpec liner;
+  liner.name = "rubber-liner";
+  liner.density = 1100.0;
+  liner.youngs_modulus = 1.0e7;
+  liner.poisson_ratio = 0.45;
+  liner.shear_modulus = 1.0e7 / 2.9;
+  liner.restitution = 0.4;
+  liner.sliding_friction = 0.9;
+  liner.rolling_friction = 0.02;
+  return {steel, ore, liner};
+}
+
+// The values of global particle k in snapshot `version` (distinct ids, materials, values
+// that are not round in binary).
+struct Expected {
+  std::int64_t id;
+  std::int32_t material;
+  Vec2 pos, vel;
+  double spin, radius;
+};
+
+Expected expected(int k, int version) {
+  const double v = version;
+  return {1000 + 37 * k,
+          static_cast<std::int32_t>(k % 3),
+          {0.1 * k + 1.0 / 3.0 + v, -0.2 * k - v / 7.0},
+          {1.5 * k - v, -k / 7.0 + 0.01 * v},
+          0.3 * k - 1.0 + v / 3.0,
+          0.01 * (k + 1)};
+}
+
+double damage(int k) { return k / 11.0; }
+
+// Rank that owns global particle k when `n` particles are split in contiguous blocks.
+int block_owner(int k, int n) { return static_cast<int>(static_cast<long>(k) * comm_size() / n); }
+
+// Fills `store` with this rank's particles (owner(k) == rank) of snapshot `version`, then
+// adds two ghosts with junk values, which must not be written.
+template <class Owner>
+std::vector<double> fill(ParticleStore& store, int n, int version, Owner owner) {
+  std::vector<double> dmg;
+  for (int k = 0; k < n; ++k) {
+    if (owner(k) != comm_rank()) continue;
+    const Expected e = expected(k, version);
+    store.add(e.id, e.material, e.radius, 7800.0, e.pos, e.vel, e.spin);
+    dmg.push_back(damage(k));
+  }
+  const std::size_t g = store.add_ghosts(2);
+  for (std::size_t i = g; i < store.size(); ++i) {
+    store.id[i] = -1;
+    store.pos[i] = {1e9, 1e9};
+  }
+  return dmg;
+}
+
+// --- Reading with the plain HDF5 C API (rank 0, after the writer is closed) ---------------
+
+struct H5Closer {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  ~H5Closer() {
+    if (id >= 0) close(id);
+  }
+};
+
+template <class T>
+std::vector<T> read_dataset(hid_t file, const std::string& name, hid_t memory_type,
+                            std::vector<hsize_t>& dims) {
+  H5Closer d{H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose};
+  EXPECT_GE(d.id, 0) << name;
+  if (d.id < 0) return {};
+  H5Closer s{H5Dget_space(d.id), H5Sclose};
+  const int rank = H5Sget_simple_extent_ndims(s.id);
+  dims.assign(static_cast<std::size_t>(rank), 0);
+  H5Sget_simple_extent_dims(s.id, dims.data(), nullptr);
+  const auto n = static_cast<std::size_t>(H5Sget_simple_extent_npoints(s.id));
+  std::vector<T> values(n);
+  if (n > 0) {
+    EXPECT_GE(H5Dread(d.id, memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+  }
+  return values;
+}
+
+template <class T>
+T read_attribute(hid_t file, const std::string& object, const std::string& name, hid_t type) {
+  H5Closer a{H5Aopen_by_name(file, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+             H5Aclose};
+  EXPECT_GE(a.id, 0) << object << "@" << name;
+  T value{};
+  if (a.id >= 0) {
+    EXPECT_GE(H5Aread(a.id, type, &value), 0);
+  }
+  return value;
+}
+
+std::vector<std::string> read_strings(hid_t file, const std::string& name) {
+  H5Closer d{H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose};
+  EXPECT_GE(d.id, 0) << name;
+  if (d.id < 0) return {};
+  H5Closer t{H5Dget_type(d.id), H5Tclose};
+  EXPECT_EQ(H5Tget_class(t.id), H5T_STRING);
+  EXPECT_EQ(H5Tis_variable_str(t.id), 0);
+  const std::size_t width = H5Tget_size(t.id);
+  H5Closer s{H5Dget_space(d.id), H5Sclose};
+  const auto n = static_cast<std::size_t>(H5Sget_simple_extent_npoints(s.id));
+  std::vector<char> buffer(n * width);
+  if (n > 0) {
+    EXPECT_GE(H5Dread(d.id, t.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()), 0);
+  }
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < n; ++i)
+    out.emplace_back(buffer.data() + i * width, strnlen(buffer.data() + i * width, width));
+  return out;
+}
+
+using Dims = std::vector<hsize_t>;
+
+// Checks /snapshots/NAME against particles [0, n) of `version`, all values exactly.
+void check_snapshot(hid_t file, const std::string& name, int n, int version, double time,
+                    std::int64_t step) {
+  SCOPED_TRACE("snapshot " + name);
+  const std::string g = "/snapshots/" + name;
+  EXPECT_EQ(read_attribute<double>(file, g, "time", H5T_NATIVE_DOUBLE), time);
+  EXPECT_EQ(read_attribute<std::int64_t>(file, g, "step", H5T_NATIVE_INT64), step);
+  const auto un = static_cast<hsize_t>(n);
+  Dims dims;
+  const auto id = read_dataset<std::int64_t>(file, g + "/id", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{un}));
+  const auto pos = read_dataset<double>(file, g + "/position", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un, 2}));
+  const auto vel = read_dataset<double>(file, g + "/velocity", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un, 2}));
+  const auto spin = read_dataset<double>(file, g + "/spin", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un}));
+  const auto radius = read_dataset<double>(file, g + "/radius", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un}));
+  const auto material = read_dataset<std::int32_t>(file, g + "/material", H5T_NATIVE_INT32, dims);
+  EXPECT_EQ(dims, (Dims{un}));
+  ASSERT_EQ(id.size(), un);
+  ASSERT_EQ(pos.size(), 2 * un);
+  ASSERT_EQ(vel.size(), 2 * un);
+  ASSERT_EQ(spin.size(), un);
+  ASSERT_EQ(radius.size(), un);
+  ASSERT_EQ(material.size(), un);
+  for (int k = 0; k < n; ++k) {
+    const Expected e = expected(k, version);
+    const auto i = static_cast<std::size_t>(k);
+    EXPECT_EQ(id[i], e.id) << "k=" << k;
+    EXPECT_EQ(material[i], e.material) << "k=" << k;
+    EXPECT_EQ(pos[2 * i], e.pos.x) << "k=" << k;
+    EXPECT_EQ(pos[2 * i + 1], e.pos.y) << "k=" << k;
+    EXPECT_EQ(vel[2 * i], e.vel.x) << "k=" << k;
+    EXPECT_EQ(vel[2 * i + 1], e.vel.y) << "k=" << k;
+    EXPECT_EQ(spin[i], e.spin) << "k=" << k;
+    EXPECT_EQ(radius[i], e.radius) << "k=" << k;
+  }
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Minimal well-formedness: every element closes, in order. Returns "" or the problem.
+std::string xml_problem(const std::string& text) {
+  std::vector<std::string> open;
+  std::size_t i = 0;
+  while ((i = text.find('<', i)) != std::string::npos) {
+    const std::size_t end = text.find('>', i);
+    if (end == std::string::npos) return "unterminated tag";
+    const std::string tag = text.substr(i + 1, end - i - 1);
+    i = end + 1;
+    if (tag.empty() || tag[0] == '?' || tag[0] == '!') continue;
+    if (tag[0] == '/') {
+      if (open.empty() || open.back() != tag.substr(1))
+        return "unexpected </" + tag.substr(1) + ">";
+      open.pop_back();
+    } else if (tag.back() != '/') {
+      open.push_back(tag.substr(0, tag.find_first_of(" \t\n")));
+    }
+  }
+  return open.empty() ? "" : "unclosed <" + open.back() + ">";
+}
+
+// Every value of `attribute="..."` in `text`.
+std::vector<std::string> attribute_values(const std::string& text, const std::string& attribute) {
+  std::vector<std::string> out;
+  const std::string key = " " + attribute + "=\"";
+  for (std::size_t i = 0; (i = text.find(key, i)) != std::string::npos;) {
+    i += key.size();
+    out.push_back(text.substr(i, text.find('"', i) - i));
+  }
+  return out;
+}
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; (i = text.find(what, i)) != std::string::npos; i += what.size()) ++n;
+  return n;
+}
+
+// --- snapshots.h5 -----------------------------------------------------------------------
+
+TEST(SnapshotWriter, TwoSnapshotsRoundTripExactly) {
+  ScratchDir dir;
+  const int n = 5;
+  const double t0 = 0.1, t1 = 0.25 + 1e-12;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    ParticleStore a;
+    fill(a, n, 0, [&](int k) { return block_owner(k, n); });
+    writer.write(a, t0, 10000);
+    ParticleStore b;
+    const std::vector<double> dmg = fill(b, n, 1, [&](int k) { return block_owner(k, n); });
+    const ExtraField extra[] = {{"damage", dmg}};
+    writer.write(b, t1, 25000, extra);
+    EXPECT_EQ(writer.snapshots_written(), 2u);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  check_snapshot(file.id, "000000", n, 0, t0, 10000);
+  check_snapshot(file.id, "000001", n, 1, t1, 25000);
+  EXPECT_GT(H5Lexists(file.id, "/snapshots/000001/damage", H5P_DEFAULT), 0);
+  EXPECT_EQ(H5Lexists(file.id, "/snapshots/000000/damage", H5P_DEFAULT), 0);
+  EXPECT_EQ(H5Lexists(file.id, "/snapshots/000002", H5P_DEFAULT), 0);
+  Dims dims;
+  const auto dmg =
+      read_dataset<double>(file.id, "/snapshots/000001/damage", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{static_cast<hsize_t>(n)}));
+  for (int k = 0; k < n && static_cast<std::size_t>(k) < dmg.size(); ++k)
+    EXPECT_EQ(dmg[static_cast<std::size_t>(k)], damage(k));
+
+  // The materials table.
+  const auto materials = test_materials();
+  EXPECT_EQ(read_strings(file.id, "/materials/name"),
+            (std::vector<std::string>{"steel", "iron ore", "rubber-liner"}));
+  auto column = [&](const char* name, double MaterialSpec::*member) {
+    Dims d;
+    const auto v =
+        read_dataset<double>(file.id, std::string("/materials/") + name, H5T_NATIVE_DOUBLE, d);
+    ASSERT_EQ(v.size(), materials.size()) << name;
+    for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(v[i], materials[i].*member) << name;
+  };
+  column("density", &MaterialSpec::density);
+  column("youngs_modulus", &MaterialSpec::youngs_modulus);
+  column("poisson_ratio", &MaterialSpec::poisson_ratio);
+  column("shear_modulus", &MaterialSpec::shear_modulus);
+  column("restitution", &MaterialSpec::restitution);
+  column("sliding_friction", &MaterialSpec::sliding_friction);
+  column("rolling_friction", &MaterialSpec::rolling_friction);
+
+  // The XDMF sidecar: well formed, one Uniform grid per snapshot with its time, every
+  // heavy-data path present in the HDF5 file.
+  ASSERT_TRUE(fs::exists(dir / "snapshots.xmf"));
+  EXPECT_FALSE(fs::exists(dir / "snapshots.xmf.tmp"));
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_NE(xmf.find("<Xdmf Version=\"3.0\""), std::string::npos);
+  EXPECT_EQ(count(xmf, "<Grid "), 3u);  // the temporal collection and two snapshots
+  EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), 2u);
+  EXPECT_EQ(count(xmf, "CollectionType=\"Temporal\""), 1u);
+  const auto times = attribute_values(xmf, "Value");
+  ASSERT_EQ(times.size(), 2u);
+  EXPECT_EQ(std::strtod(times[0].c_str(), nullptr), t0);
+  EXPECT_EQ(std::strtod(times[1].c_str(), nullptr), t1);
+  for (const auto& v : attribute_values(xmf, "NumberOfElements")) EXPECT_EQ(v, "5");
+  std::size_t references = 0;
+  for (std::size_t i = 0; (i = xmf.find("snapshots.h5:", i)) != std::string::npos; ++references) {
+    i += 13;
+    const std::string path = xmf.substr(i, xmf.find('<', i) - i);
+    EXPECT_GT(H5Lexists(file.id, path.c_str(), H5P_DEFAULT), 0) << path;
+  }
+  // Per snapshot: topology, position, velocity, spin, radius, material, id; then damage.
+  EXPECT_EQ(references, 2u * 7u + 1u);
+  EXPECT_EQ(count(xmf, "<Attribute Name=\"velocity\" AttributeType=\"Vector\""), 2u);
+  EXPECT_EQ(count(xmf, "Name=\"damage\""), 1u);
+  // The Polyvertex connectivity, shared by both snapshots of 5 particles.
+  const auto vertices =
+      read_dataset<std::int64_t>(file.id, "/xdmf/polyvertex_5", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(vertices, (std::vector<std::int64_t>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(count(xmf, "snapshots.h5:/xdmf/polyvertex_5<"), 2u);
+}
+
+TEST(SnapshotWriter, OneRankOwnsEverything) {
+  // All particles on the last rank: with 2+ ranks, rank 0 owns none.
+  ScratchDir dir;
+  const int n = 4;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    ParticleStore a;
+    fill(a, n, 2, [](int) { return comm_size() - 1; });
+    writer.write(a, 1.0, 7);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  check_snapshot(file.id, "000000", n, 2, 1.0, 7);
+}
+
+TEST(SnapshotWriter, NoParticlesAnywhere) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    ParticleStore empty;
+    writer.write(empty, 0.0, 0);
+    writer.write(empty, 0.5, 50);
+    writer.close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  check_snapshot(file.id, "000000", 0, 0, 0.0, 0);
+  check_snapshot(file.id, "000001", 0, 0, 0.5, 50);
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), 2u);
+}
+
+TEST(SnapshotWriter, EmptyMaterialTable) {
+  ScratchDir dir;
+  { SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), {}); }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_TRUE(read_strings(file.id, "/materials/name").empty());
+  EXPECT_GT(H5Lexists(file.id, "/snapshots", H5P_DEFAULT), 0);
+  EXPECT_FALSE(fs::exists(dir / "snapshots.xmf"));  // nothing to show yet
+}
+
+TEST(SnapshotWriter, StaleSidecarIsRemoved) {
+  ScratchDir dir;
+  if (comm_rank() == 0) std::ofstream(dir / "snapshots.xmf") << "old";
+  MPI_Barrier(MPI_COMM_WORLD);
+  { SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials()); }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() == 0) {
+    EXPECT_FALSE(fs::exists(dir / "snapshots.xmf"));
+  }
+}
+
+void expect_same_io_error_everywhere(const std::function<void()>& f, const std::string& prefix) {
+  std::string message;
+  try {
+    f();
+    ADD_FAILURE() << "no IoError";
+  } catch (const IoError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message.rfind(prefix, 0), 0u) << "message: " << message;
+  if (prefix.ends_with(": ")) {
+    EXPECT_GT(message.size(), prefix.size()) << "no reason given";
+  }
+  if (std::getenv("DEM2D_SHOW_ERRORS") != nullptr && comm_rank() == 0) {
+    std::printf("[ message  ] %s\n", message.c_str());
+  }
+  EXPECT_EQ(message, rank0_string(message)) << "ranks disagree";
+}
+
+TEST(SnapshotWriter, UnwritableDirectoryFailsOnEveryRank) {
+  ScratchDir dir;
+  if (comm_rank() == 0) std::ofstream(dir / "plain_file") << "x";
+  MPI_Barrier(MPI_COMM_WORLD);
+  const std::string as_dir = dir / "plain_file";
+  expect_same_io_error_everywhere(
+      [&] { SnapshotWriter w(MPI_COMM_WORLD, as_dir, test_materials()); },
+      "cannot create " + as_dir + "/snapshots.h5: ");
+  const std::string missing = dir / "no/such/dir";
+  expect_same_io_error_everywhere(
+      [&] { SnapshotWriter w(MPI_COMM_WORLD, missing, test_materials()); },
+      "cannot create " + missing + "/snapshots.h5: No such file or directory");
+}
+
+TEST(ParallelFile, ErrorsNameTheFileAndTheObject) {
+  ScratchDir dir;
+  const std::string missing = dir / "no/such/t.h5";  // MPI-IO's own open fails on every rank
+  expect_same_io_error_everywhere([&] { h5::ParallelFile::create(MPI_COMM_WORLD, missing); },
+                                  "cannot create " + missing + ": ");
+  const std::string path = dir / "t.h5";
+  auto f = h5::ParallelFile::create(MPI_COMM_WORLD, path);
+  f.create_group("/a/b");  // with its parent
+  expect_same_io_error_everywhere([&] { f.create_group("/a/b"); },
+                                  path + ": cannot create group '/a/b': ");
+  const double x = 1.0;
+  f.write_rows("/a/x", h5::rank0_rows(MPI_COMM_WORLD, 1), comm_rank() == 0 ? &x : nullptr);
+  expect_same_io_error_everywhere(
+      [&] { f.write_rows("/a/x", h5::rank0_rows(MPI_COMM_WORLD, 1), &x); },
+      path + ": cannot create dataset '/a/x': ");
+  f.close();
+}
+
+TEST(ParallelFile, RowRangeIsAnExclusiveScan) {
+  const int r = comm_rank();
+  const h5::RowRange range = h5::row_range(MPI_COMM_WORLD, static_cast<std::size_t>(r + 1));
+  const auto s = static_cast<std::uint64_t>(comm_size());
+  EXPECT_EQ(range.offset, static_cast<std::uint64_t>(r * (r + 1) / 2));
+  EXPECT_EQ(range.count, static_cast<std::uint64_t>(r + 1));
+  EXPECT_EQ(range.total, s * (s + 1) / 2);
+}
+
+// --- series.csv -------------------------------------------------------------------------
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  for (std::string cell; std::getline(ss, cell, ',');) out.push_back(cell);
+  return out;
+}
+
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+TEST(SeriesWriter, HeaderAndRowsRoundTripBitExactly) {
+  ScratchDir dir;
+  if (comm_rank() != 0) return;  // series.csv is rank 0's alone
+  const std::string path = dir / "series.csv";
+  SeriesRow row;
+  row.time = 0.1;
+  row.step = 1234567890123;
+  row.particles = 240;
+  row.contacts = 531;
+  row.kinetic_energy = 1.0 / 3.0;
+  row.rotational_energy = 4.9406564584124654e-324;  // smallest subnormal
+  row.potential_energy = -1234.5678901234567;
+  row.elastic_energy = 1.7976931348623157e308;
+  row.dissipated_energy = std::nextafter(1.0, 2.0);
+  row.drum_torque = -0.0;
+  row.drum_power = 2.0 / 7.0 * 1e-17;
+  row.drive_work = 6.02214076e23;
+  row.passes = 3.25;
+  {
+    SeriesWriter w(path, true, true);
+    w.write(row);
+    SeriesRow second = row;
+    second.time = 0.2;
+    w.write(second);
+    // Flushed row by row: readable before the writer closes.
+    EXPECT_EQ(count(read_text(path), "\n"), 3u);
+  }
+  std::ifstream in(path);
+  std::string header, line, second_line, extra;
+  std::getline(in, header);
+  std::getline(in, line);
+  std::getline(in, second_line);
+  EXPECT_FALSE(std::getline(in, extra));
+  EXPECT_EQ(header,
+            "time,step,particles,contacts,kinetic_energy,rotational_energy,potential_energy,"
+            "elastic_energy,dissipated_energy,drum_torque,drum_power,drive_work,passes");
+  const auto cells = split(line);
+  ASSERT_EQ(cells.size(), 13u);
+  const double doubles[] = {row.time,
+                            row.kinetic_energy,
+                            row.rotational_energy,
+                            row.potential_energy,
+                            row.elastic_energy,
+                            row.dissipated_energy,
+                            row.drum_torque,
+                            row.drum_power,
+                            row.drive_work,
+                            row.passes};
+  const int double_columns[] = {0, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  for (int i = 0; i < 10; ++i) {
+    const std::string& cell = cells[static_cast<std::size_t>(double_columns[i])];
+    EXPECT_TRUE(same_bits(std::strtod(cell.c_str(), nullptr), doubles[i]))
+        << "column " << double_columns[i] << ": " << cell;
+  }
+  EXPECT_EQ(cells[1], "1234567890123");
+  EXPECT_EQ(cells[2], "240");
+  EXPECT_EQ(cells[3], "531");
+  EXPECT_EQ(split(second_line)[0], "0.20000000000000001");
+}
+
+TEST(SeriesWriter, VerletHasNoPassesColumnAndInactiveWritesNothing) {
+  ScratchDir dir;
+  if (comm_rank() != 0) return;
+  {
+    SeriesWriter w(dir / "series.csv", false, true);
+    w.write(SeriesRow{});
+  }
+  std::ifstream in(dir / "series.csv");
+  std::string header, line;
+  std::getline(in, header);
+  std::getline(in, line);
+  EXPECT_EQ(split(header), series_columns(false));
+  EXPECT_EQ(split(header).back(), "drive_work");
+  EXPECT_EQ(line, "0,0,0,0,0,0,0,0,0,0,0,0");
+  {
+    SeriesWriter inactive(dir / "other.csv", true, false);
+    inactive.write(SeriesRow{});
+  }
+  EXPECT_FALSE(fs::exists(dir / "other.csv"));
+  // Inactive on an unwritable path: no error either (only rank 0 writes).
+  EXPECT_NO_THROW(SeriesWriter("/proc/dem2d_no/series.csv", false, false));
+}
+
+TEST(SeriesWriter, UnwritablePathIsAnIoErrorNamingIt) {
+  try {
+    SeriesWriter w("/proc/dem2d_no/series.csv", false, true);
+    FAIL() << "no IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("cannot create /proc/dem2d_no/series.csv: ", 0), 0u)
+        << e.what();
+  }
+}
+
+TEST(SeriesWriter, FullDiskIsAnIoError) {
+  if (comm_rank() != 0) return;
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  try {
+    SeriesWriter w("/dev/full", false, true);  // the header's flush fails
+    FAIL() << "no IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot write /dev/full: No space left on device");
+  }
+}
+
+// --- output directory -------------------------------------------------------------------
+
+TEST(OutputDirectory, CreatesNestedDirectoriesAndLeavesNoProbe) {
+  ScratchDir dir;
+  const std::string out = dir / "a/b/c";
+  prepare_output_directory(MPI_COMM_WORLD, out);
+  MPI_Barrier(MPI_COMM_WORLD);
+  EXPECT_TRUE(fs::is_directory(out));
+  EXPECT_TRUE(fs::is_empty(out));
+  MPI_Barrier(MPI_COMM_WORLD);                    // every rank looked before rank 0 probes again
+  prepare_output_directory(MPI_COMM_WORLD, out);  // existing: fine
+}
+
+TEST(OutputDirectory, UnwritableIsTheSameIoErrorOnEveryRank) {
+  ScratchDir dir;
+  expect_same_io_error_everywhere(
+      [] { prepare_output_directory(MPI_COMM_WORLD, "/proc/dem2d_no"); },
+      "cannot write to output directory '/proc/dem2d_no': ");
+  if (comm_rank() == 0) std::ofstream(dir / "plain_file") << "x";
+  MPI_Barrier(MPI_COMM_WORLD);
+  const std::string under_file = dir / "plain_file/sub";
+  expect_same_io_error_everywhere([&] { prepare_output_directory(MPI_COMM_WORLD, under_file); },
+                                  "cannot write to output directory '" + under_file + "': ");
+  const std::string file_itself = dir / "plain_file";
+  expect_same_io_error_everywhere([&] { prepare_output_directory(MPI_COMM_WORLD, file_itself); },
+                                  "cannot write to output directory '" + file_itself + "': ");
+}
+
+}  // namespace
+}  // namespace dem2d
