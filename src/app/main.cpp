@@ -19,6 +19,7 @@
 
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
+#include "io/agree.hpp"
 #include "io/deck.hpp"
 #include "io/output_dir.hpp"
 #include "io/run_json.hpp"
@@ -147,9 +148,38 @@ int run(const Options& opt) {
     return kExitOk;
   }
   const OutputSpec& out = scene.output;
-  prepare_output_directory(MPI_COMM_WORLD, out.directory);
-  SeriesWriter series(out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative,
-                      g_rank == 0);
+  try {
+    prepare_output_directory(MPI_COMM_WORLD, out.directory);
+  } catch (const IoError& e) {
+    // An output directory that cannot be written is bad input (exit 2), named by its key;
+    // a write that fails later (disk full) stays an I/O failure (exit 4).
+    const std::string source = opt.output.empty() ? scene.deck_path + ": error: output.directory = '" +
+                                                        out.directory + "': "
+                                                  : "--output " + opt.output + ": error: ";
+    throw InputError(source + e.what() + "; give a directory you can write to");
+  }
+  // Rank 0 alone writes series.csv; every write is agreed on, so a failure there (disk full)
+  // stops every rank with the same message instead of leaving the others in a collective.
+  std::unique_ptr<SeriesWriter> series_file;
+  {
+    std::string error;
+    try {
+      series_file = std::make_unique<SeriesWriter>(
+          out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative, g_rank == 0);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    throw_if_any_rank_failed(MPI_COMM_WORLD, error);
+  }
+  const auto write_row = [&](const SeriesRow& row) {
+    std::string error;
+    try {
+      series_file->write(row);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    throw_if_any_rank_failed(MPI_COMM_WORLD, error);
+  };
   SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
   if (!opt.quiet)
     say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(sim.particles().n_owned()) +
@@ -165,7 +195,7 @@ int run(const Options& opt) {
   Progress progress(opt.quiet, scene.run.duration, out.progress_interval);
   const auto start = Clock::now();
   double last_snapshot_time = -1.0;
-  series.write(sim.diagnostics());
+  write_row(sim.diagnostics());
   sim.reset_pass_window();
   if (out.snapshot_interval > 0) {
     snapshots.write(output_view(sim), sim.time(), sim.step_count());
@@ -175,7 +205,7 @@ int run(const Options& opt) {
     while (sim.time() + 0.5 * dt < scene.run.duration) {
       sim.step();
       if (at_multiple(sim.time(), out.series_interval)) {
-        series.write(sim.diagnostics());
+        write_row(sim.diagnostics());
         sim.reset_pass_window();
       }
       if (at_multiple(sim.time(), out.snapshot_interval)) {
@@ -192,7 +222,7 @@ int run(const Options& opt) {
     return kExitUnstable;
   }
   if (last_snapshot_time != sim.time()) snapshots.write(output_view(sim), sim.time(), sim.step_count());
-  if (!at_multiple(sim.time(), out.series_interval)) series.write(sim.diagnostics());
+  if (!at_multiple(sim.time(), out.series_interval)) write_row(sim.diagnostics());
   progress.update(sim, true);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   RunInfo info;

@@ -1,0 +1,172 @@
+#!/usr/bin/python3
+"""Compare two dem2d snapshots.h5 files snapshot by snapshot, particles matched by id.
+
+    post/h5compare.py A/snapshots.h5 B/snapshots.h5 [--atol 0] [--show 10]
+
+Within each snapshot both files' particles are sorted by id, so runs on different rank counts
+(whose files hold the particles in a different order) compare equal when the physics is the
+same. Compared: the number and names of snapshots, their time and step attributes, the set of
+ids, every per-particle dataset (id, position, velocity, spin, radius, material, and any extra
+field such as damage) and the /materials table. /xdmf (ParaView helper data) is ignored.
+
+Exit status: 0 when the files are bit-identical (or, with --atol, every floating-point value
+is within atol and everything else is identical); 1 otherwise, after printing the first
+differences and the largest absolute difference of each field; 2 for a usage or file error.
+"""
+
+import argparse
+import sys
+
+import h5py
+import numpy as np
+
+
+class Report:
+    def __init__(self, show):
+        self.show = show
+        self.shown = 0
+        self.differences = 0
+        self.max_abs = {}  # field -> largest |a - b|
+
+    def differ(self, text):
+        self.differences += 1
+        if self.shown < self.show:
+            print(text)
+            self.shown += 1
+
+    def note_max(self, field, value):
+        self.max_abs[field] = max(self.max_abs.get(field, 0.0), value)
+
+
+def fmt(x):
+    return repr(x.item()) if hasattr(x, "item") else repr(x)
+
+
+def same_bits(a, b):
+    return a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def compare_arrays(where, field, a, b, ids, atol, report):
+    """Compare two arrays of equal length (rows matched); record the differences."""
+    key = field if where.startswith("/snapshots") else f"{where.lstrip('/')}/{field}"
+    if a.shape != b.shape:
+        report.differ(f"{where}/{field}: shape {a.shape} vs {b.shape}")
+        return
+    if same_bits(a, b):
+        report.note_max(key, 0.0)
+        return
+    floating = np.issubdtype(a.dtype, np.floating) and np.issubdtype(b.dtype, np.floating)
+    if floating:
+        a64, b64 = a.astype(np.float64), b.astype(np.float64)
+        both_nan = np.isnan(a64) & np.isnan(b64)
+        diff = np.where(both_nan, 0.0, np.abs(a64 - b64))
+        diff = np.where(np.isnan(diff), np.inf, diff)  # nan vs number
+        # Bitwise: -0.0 vs 0.0 or different NaN payloads differ too.
+        bits_differ = a64.view(np.uint64) != b64.view(np.uint64)
+        bad = (diff > atol) | (bits_differ & (atol == 0))
+        report.note_max(key, float(diff.max()) if diff.size else 0.0)
+    else:
+        bad = a != b
+        if np.issubdtype(a.dtype, np.number) and np.issubdtype(b.dtype, np.number):
+            d = np.abs(a.astype(np.float64) - b.astype(np.float64))
+            report.note_max(key, float(d.max()) if d.size else 0.0)
+    if bad.ndim > 1:
+        rows = np.nonzero(bad.any(axis=tuple(range(1, bad.ndim))))[0]
+    else:
+        rows = np.nonzero(bad)[0]
+    for row in rows:
+        label = f"id {ids[row]}" if ids is not None else f"row {row}"
+        report.differ(f"{where}/{field}: {label}: {fmt(a[row]) if a.ndim == 1 else a[row].tolist()}"
+                      f" vs {fmt(b[row]) if b.ndim == 1 else b[row].tolist()}")
+
+
+def compare_snapshot(name, ga, gb, atol, report):
+    where = f"/snapshots/{name}"
+    for attr in ("time", "step"):
+        va, vb = ga.attrs.get(attr), gb.attrs.get(attr)
+        if va is None or vb is None or not same_bits(np.asarray(va), np.asarray(vb)):
+            if attr == "time" and va is not None and vb is not None and abs(va - vb) <= atol:
+                continue
+            report.differ(f"{where}@{attr}: {fmt(va)} vs {fmt(vb)}")
+    ida, idb = ga["id"][()], gb["id"][()]
+    for label, ids in (("first", ida), ("second", idb)):
+        if len(np.unique(ids)) != len(ids):
+            report.differ(f"{where}/id: duplicate ids in the {label} file")
+    common, ia, ib = np.intersect1d(ida, idb, assume_unique=False, return_indices=True)
+    only_a = np.setdiff1d(ida, idb)
+    only_b = np.setdiff1d(idb, ida)
+    if len(only_a) or len(only_b):
+        report.differ(f"{where}/id: {len(only_a)} ids only in the first file "
+                      f"{only_a[:5].tolist()}, {len(only_b)} only in the second {only_b[:5].tolist()}")
+    fields = sorted(set(ga.keys()) | set(gb.keys()))
+    for field in fields:
+        if field not in ga or field not in gb:
+            report.differ(f"{where}/{field}: only in the {'first' if field in ga else 'second'} file")
+            continue
+        a, b = ga[field][()], gb[field][()]
+        if len(a) != len(ida) or len(b) != len(idb):
+            report.differ(f"{where}/{field}: {len(a)} and {len(b)} rows for {len(ida)} and "
+                          f"{len(idb)} particles")
+            continue
+        compare_arrays(where, field, a[ia], b[ib], common, atol, report)
+
+
+def compare_materials(fa, fb, atol, report):
+    ma, mb = fa.get("materials"), fb.get("materials")
+    if ma is None or mb is None:
+        if (ma is None) != (mb is None):
+            report.differ("/materials: only in one file")
+        return
+    for field in sorted(set(ma.keys()) | set(mb.keys())):
+        if field not in ma or field not in mb:
+            report.differ(f"/materials/{field}: only in one file")
+            continue
+        a, b = ma[field][()], mb[field][()]
+        if a.dtype.kind in "SOU" or b.dtype.kind in "SOU":
+            if a.tolist() != b.tolist():
+                report.differ(f"/materials/{field}: {a.tolist()} vs {b.tolist()}")
+            continue
+        compare_arrays("/materials", field, a, b, None, atol, report)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("first", help="a snapshots.h5")
+    parser.add_argument("second", help="another snapshots.h5")
+    parser.add_argument("--atol", type=float, default=0.0,
+                        help="accept floating-point differences up to this (default 0: bit-identical)")
+    parser.add_argument("--show", type=int, default=10, help="differences to print (default 10)")
+    args = parser.parse_args(argv)
+    try:
+        fa = h5py.File(args.first, "r")
+        fb = h5py.File(args.second, "r")
+    except OSError as e:
+        print(f"h5compare.py: {e}", file=sys.stderr)
+        return 2
+    report = Report(args.show)
+    with fa, fb:
+        compare_materials(fa, fb, args.atol, report)
+        sa = sorted(fa["snapshots"].keys()) if "snapshots" in fa else []
+        sb = sorted(fb["snapshots"].keys()) if "snapshots" in fb else []
+        if sa != sb:
+            report.differ(f"/snapshots: {len(sa)} snapshots vs {len(sb)}; "
+                          f"only in the first: {sorted(set(sa) - set(sb))[:5]}, "
+                          f"only in the second: {sorted(set(sb) - set(sa))[:5]}")
+        common = [n for n in sa if n in set(sb)]
+        for name in common:
+            compare_snapshot(name, fa["snapshots"][name], fb["snapshots"][name], args.atol, report)
+    if report.differences == 0:
+        what = "bit-identical" if args.atol == 0 else f"identical within atol = {args.atol:g}"
+        print(f"{len(common)} snapshots {what}")
+        return 0
+    if report.differences > report.shown:
+        print(f"... {report.differences - report.shown} more differences")
+    print(f"{report.differences} differences in {len(common)} common snapshots; "
+          "max |difference| per field:")
+    for field, value in sorted(report.max_abs.items()):
+        print(f"  {field:28s} {value:.17g}")
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

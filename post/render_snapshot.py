@@ -1,0 +1,192 @@
+#!/usr/bin/python3
+"""Draw the particles of a dem2d snapshots.h5 as circles, coloured by material or speed.
+
+    post/render_snapshot.py OUT/snapshots.h5                   # last snapshot -> PNG
+    post/render_snapshot.py OUT/snapshots.h5 --index 0 --color speed -o first.png
+    post/render_snapshot.py OUT/snapshots.h5 --all -o frames/  # every snapshot, one PNG each
+    post/render_snapshot.py OUT/snapshots.h5 --list            # what the file holds
+
+The drum is drawn when its radius is known: from --drum-radius / --drum-center, or else from
+run.json beside the HDF5 file ({"deck": {"drum": {"radius": R, "center": [x, y]}}}).
+Particles are drawn at their true radius (in data units), so a packing looks like a packing.
+"""
+
+import argparse
+import json
+import os
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.collections import EllipseCollection  # noqa: E402
+from matplotlib.patches import Circle, Patch  # noqa: E402
+
+
+def snapshot_names(f):
+    return sorted(f["snapshots"].keys()) if "snapshots" in f else []
+
+
+def material_names(f):
+    if "materials/name" not in f:
+        return []
+    return [n.decode() if isinstance(n, bytes) else str(n) for n in f["materials/name"][()]]
+
+
+def read_snapshot(f, name):
+    g = f["snapshots"][name]
+    return {
+        "name": name,
+        "time": float(g.attrs["time"]),
+        "step": int(g.attrs["step"]),
+        "position": np.asarray(g["position"][()]).reshape(-1, 2),
+        "velocity": np.asarray(g["velocity"][()]).reshape(-1, 2),
+        "radius": np.asarray(g["radius"][()]),
+        "material": np.asarray(g["material"][()]),
+    }
+
+
+def drum_geometry(args):
+    """(radius, (cx, cy)) of the drum, or None."""
+    if args.drum_radius is not None:
+        return args.drum_radius, tuple(args.drum_center or (0.0, 0.0))
+    run_json = args.run_json or os.path.join(os.path.dirname(os.path.abspath(args.snapshots)),
+                                             "run.json")
+    if not os.path.exists(run_json):
+        return None
+    try:
+        with open(run_json, encoding="utf-8") as fh:
+            drum = json.load(fh).get("deck", {}).get("drum", {})
+    except (OSError, ValueError) as e:
+        print(f"render_snapshot.py: ignoring {run_json}: {e}", file=sys.stderr)
+        return None
+    radius = drum.get("radius") if isinstance(drum, dict) else None
+    if not radius or radius <= 0 or drum.get("present") is False:
+        return None
+    center = drum.get("center", [0.0, 0.0])
+    if args.drum_center:
+        center = args.drum_center
+    return float(radius), (float(center[0]), float(center[1]))
+
+
+def render(snap, materials, drum, color, speed_max, out, size, dpi):
+    pos, r = snap["position"], snap["radius"]
+    fig, ax = plt.subplots(figsize=(size, size), constrained_layout=True)
+    ax.set_aspect("equal")
+    if drum is not None:
+        radius, center = drum
+        ax.add_patch(Circle(center, radius, fill=False, color="0.3", linewidth=1.5))
+        margin = 0.05 * radius
+        ax.set_xlim(center[0] - radius - margin, center[0] + radius + margin)
+        ax.set_ylim(center[1] - radius - margin, center[1] + radius + margin)
+    elif len(r):
+        lo = (pos - r[:, None]).min(axis=0)
+        hi = (pos + r[:, None]).max(axis=0)
+        margin = 0.05 * max(hi[0] - lo[0], hi[1] - lo[1], 2 * float(r.max()))
+        ax.set_xlim(lo[0] - margin, hi[0] + margin)
+        ax.set_ylim(lo[1] - margin, hi[1] + margin)
+
+    if len(r):
+        kwargs = dict(widths=2 * r, heights=2 * r, angles=np.zeros_like(r), units="xy",
+                      offsets=pos, edgecolors="0.15", linewidths=0.3)
+        try:
+            circles = EllipseCollection(offset_transform=ax.transData, **kwargs)
+        except TypeError:  # matplotlib < 3.6
+            circles = EllipseCollection(transOffset=ax.transData, **kwargs)
+        if color == "speed":
+            speed = np.hypot(snap["velocity"][:, 0], snap["velocity"][:, 1])
+            circles.set_array(speed)
+            circles.set_cmap("viridis")
+            circles.set_clim(0.0, speed_max if speed_max > 0 else 1.0)
+            ax.add_collection(circles)
+            fig.colorbar(circles, ax=ax, shrink=0.8, label="speed [m/s]")
+        else:
+            cmap = plt.get_cmap("tab10")
+            mat = snap["material"].astype(int)
+            circles.set_facecolor([cmap(m % 10) for m in mat])
+            ax.add_collection(circles)
+            used = sorted(set(mat.tolist()))
+            labels = [materials[m] if 0 <= m < len(materials) else f"material {m}" for m in used]
+            ax.legend(handles=[Patch(color=cmap(m % 10), label=lab) for m, lab in zip(used, labels)],
+                      loc="upper right", fontsize="small")
+    ax.set_title(f"snapshot {snap['name']}   t = {snap['time']:.6g} s   step {snap['step']}"
+                 f"   {len(r)} particles")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    fig.savefig(out, dpi=dpi)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("snapshots", help="snapshots.h5 written by dem2d")
+    which = parser.add_mutually_exclusive_group()
+    which.add_argument("--index", type=int, default=-1,
+                       help="snapshot to draw, 0-based; negative counts from the end (default -1)")
+    which.add_argument("--all", action="store_true", help="draw every snapshot as a frame")
+    which.add_argument("--list", action="store_true", help="list the snapshots and exit")
+    parser.add_argument("--color", choices=["material", "speed"], default="material")
+    parser.add_argument("--drum-radius", type=float, help="drum radius [m] (default: run.json)")
+    parser.add_argument("--drum-center", type=float, nargs=2, metavar=("X", "Y"),
+                        help="drum centre [m] (default: run.json, or 0 0)")
+    parser.add_argument("--run-json", help="run.json to read the drum from "
+                        "(default: run.json beside the HDF5 file)")
+    parser.add_argument("-o", "--output",
+                        help="PNG to write (default: snapshot_NNNNNN.png beside the HDF5 file); "
+                        "with --all, a directory for frame_NNNNNN.png (default: frames/ beside it)")
+    parser.add_argument("--size", type=float, default=7.0, help="figure size [inch]")
+    parser.add_argument("--dpi", type=int, default=120)
+    args = parser.parse_args(argv)
+
+    try:
+        f = h5py.File(args.snapshots, "r")
+    except OSError as e:
+        print(f"render_snapshot.py: cannot open {args.snapshots}: {e}", file=sys.stderr)
+        return 1
+    with f:
+        names = snapshot_names(f)
+        if args.list:
+            for i, name in enumerate(names):
+                g = f["snapshots"][name]
+                print(f"{i:6d}  {name}  t = {float(g.attrs['time']):.17g}  "
+                      f"step {int(g.attrs['step'])}  {g['id'].shape[0]} particles")
+            return 0
+        if not names:
+            print(f"render_snapshot.py: {args.snapshots} holds no snapshots", file=sys.stderr)
+            return 1
+        materials = material_names(f)
+        drum = drum_geometry(args)
+        base = os.path.dirname(os.path.abspath(args.snapshots))
+        if args.all:
+            outdir = args.output or os.path.join(base, "frames")
+            os.makedirs(outdir, exist_ok=True)
+            speed_max = 0.0
+            if args.color == "speed":  # one colour scale for the whole sequence
+                for name in names:
+                    v = np.asarray(f["snapshots"][name]["velocity"][()]).reshape(-1, 2)
+                    if len(v):
+                        speed_max = max(speed_max, float(np.hypot(v[:, 0], v[:, 1]).max()))
+            for name in names:
+                out = os.path.join(outdir, f"frame_{name}.png")
+                render(read_snapshot(f, name), materials, drum, args.color, speed_max, out,
+                       args.size, args.dpi)
+            print(f"{outdir}: {len(names)} frames")
+            return 0
+        if not -len(names) <= args.index < len(names):
+            print(f"render_snapshot.py: no snapshot {args.index} ({len(names)} in the file)",
+                  file=sys.stderr)
+            return 1
+        snap = read_snapshot(f, names[args.index])
+        speed = np.hypot(snap["velocity"][:, 0], snap["velocity"][:, 1])
+        out = args.output or os.path.join(base, f"snapshot_{snap['name']}.png")
+        render(snap, materials, drum, args.color, float(speed.max()) if len(speed) else 0.0, out,
+               args.size, args.dpi)
+        print(f"{out}: snapshot {snap['name']}, t = {snap['time']:.6g} s, {len(speed)} particles")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

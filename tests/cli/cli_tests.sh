@@ -1,0 +1,77 @@
+#!/usr/bin/env bash
+# Command-line contract (interface.md): exit codes and messages for good and bad input, on one
+# and on two ranks. Usage: cli_tests.sh PATH/TO/dem2d SOURCE_DIR
+set -u
+dem2d=$1
+src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+failures=0
+pass() { echo "ok   $1"; }
+fail() { echo "FAIL $1"; failures=$((failures + 1)); }
+
+# expect NAME CODE PATTERN -- COMMAND...: exit status CODE and stdout+stderr matching PATTERN.
+expect() {
+  local name=$1 code=$2 pattern=$3
+  shift 4
+  local out
+  out=$("$@" 2>&1)
+  local got=$?
+  if [ "$got" -ne "$code" ]; then fail "$name: exit $got, expected $code"; echo "$out" | head -5; return; fi
+  if ! grep -qE -- "$pattern" <<<"$out"; then fail "$name: output lacks /$pattern/"; echo "$out" | head -5; return; fi
+  if grep -qE "MPI_ABORT|Segmentation|core dumped|terminate called|Aborted" <<<"$out"; then
+    fail "$name: crash or abort trace"; echo "$out" | head -5; return
+  fi
+  pass "$name"
+}
+
+cp "$src/inputs/drop.in" "$tmp/typo.in"
+sed -i 's/^restitution = 0.73/restituion = 0.73/; s/^density = 7800.0/density = -7800.0/' "$tmp/typo.in"
+printf 'title = "x"\n[run\nduration = 1\n' > "$tmp/syntax.in"
+cp "$src/inputs/drop.in" "$tmp/model.in"
+sed -i 's/^model = "hertz-mindlin"/model = "hertz"/' "$tmp/model.in"
+
+for np in 1 2; do
+  run=("$dem2d")
+  [ "$np" -gt 1 ] && run=(mpirun -np "$np" --oversubscribe "$dem2d")
+  expect "np$np version" 0 '^dem2d [0-9]+\.[0-9]+\.[0-9]+' -- "${run[@]}" --version
+  expect "np$np no deck" 2 'no input deck' -- "${run[@]}"
+  expect "np$np unknown option" 2 'not expected' -- "${run[@]}" --bogus
+  expect "np$np missing deck" 2 'nope\.in: error: cannot open deck' -- "${run[@]}" "$tmp/nope.in"
+  expect "np$np misspelt key suggests" 2 "typo\.in:[0-9]+:[0-9]+: error: unknown key 'restituion'.*did you mean 'restitution'" -- "${run[@]}" "$tmp/typo.in"
+  expect "np$np all errors reported" 2 'material\[0\]\.density = -7800.*must be > 0' -- "${run[@]}" "$tmp/typo.in"
+  expect "np$np syntax error located" 2 'syntax\.in:2:[0-9]+: error' -- "${run[@]}" "$tmp/syntax.in"
+  expect "np$np bad choice lists allowed" 2 'model\.in:[0-9]+:[0-9]+: error: .*"hertz-mindlin"' -- "${run[@]}" "$tmp/model.in"
+  expect "np$np bad --set" 2 'did you mean' -- "${run[@]}" "$src/inputs/drop.in" --set run.durration=1
+  expect "np$np unsafe dt names the safe dt" 2 'run\.dt = 0\.01 s is unsafe.*safe dt is' -- "${run[@]}" "$src/inputs/drop.in" --set run.dt=0.01
+  expect "np$np unwritable output" 2 "output/x.*cannot write|--output .*error" -- "${run[@]}" "$src/inputs/drop.in" --quiet --output /proc/output/x
+done
+
+# --check prints the derived quantities; --set reaches them.
+expect "check waterfall" 0 'fill fraction: +0\.3840' -- "$dem2d" --check "$src/inputs/waterfall.in"
+expect "check critical speed" 0 'critical speed: +1\.98' -- "$dem2d" --check "$src/inputs/waterfall.in"
+expect "check --set speed" 0 'drum speed: +1\.5000 rad/s' -- "$dem2d" --check "$src/inputs/waterfall.in" --set drum.speed=1.5
+for deck in "$src"/inputs/*.in; do
+  expect "check $(basename "$deck")" 0 'the deck is valid' -- "$dem2d" --check "$deck"
+done
+
+# A short run writes every output, and series.csv's energies add up.
+expect "short run np2" 0 'done: 0.5 s simulated' -- mpirun -np 2 --oversubscribe "$dem2d" "$src/inputs/drop.in" \
+  --set run.duration=0.5 --output "$tmp/drop"
+for f in series.csv snapshots.h5 snapshots.xmf run.json; do
+  [ -s "$tmp/drop/$f" ] && pass "output $f written" || fail "output $f missing"
+done
+head -1 "$tmp/drop/series.csv" | grep -q '^time,step,particles,contacts,kinetic_energy,rotational_energy,potential_energy,elastic_energy,dissipated_energy,drum_torque,drum_power' \
+  && pass "series.csv columns" || fail "series.csv columns"
+grep -q '"ranks": 2' "$tmp/drop/run.json" && pass "run.json records 2 ranks" || fail "run.json ranks"
+
+# A run that blows up: exit 3, the step and particle ids named, a last snapshot, no NaN written.
+expect "unstable run exits 3" 3 'unstable at step [0-9]+.*particle [0-9]+ and particle [0-9]+.*safe dt is' -- "$dem2d" \
+  "$src/inputs/centrifuge.in" --quiet --set run.dt=5e-4 --set run.allow_unsafe_dt=true --set run.duration=0.3 \
+  --output "$tmp/boom"
+[ -s "$tmp/boom/snapshots.h5" ] && pass "unstable run left a snapshot" || fail "no snapshot after blow-up"
+if grep -qiE 'nan|inf' "$tmp/boom/series.csv"; then fail "NaN/inf in series.csv"; else pass "no NaN in series.csv"; fi
+
+echo "cli: $failures failure(s)"
+[ "$failures" -eq 0 ]
