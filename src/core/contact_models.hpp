@@ -170,7 +170,8 @@ struct RollingConstant {
 
 // Elastic-plastic spring-dashpot (Ai et al. 2011 model C):
 //   k_r = 2.25 k_n mu_r^2 R*^2, M_k += -k_r w_rel dt, |M_k| <= M_max = mu_r R* F_n,
-//   M_d = -eta_r 2 sqrt(I_r k_r) w_rel while |M_k| < M_max (off at full mobilisation).
+//   M_d = -eta_r 2 sqrt(I_r k_r) w_rel while |M_k| < M_max (off at full mobilisation), and
+//   |M_k + M_d| <= M_max: the dashpot cannot push the torque past the cap either.
 // eta_r is `rolling_damping` (ContactSpec), passed in as `eta`.
 struct RollingEpsd {
   static constexpr bool kActive = true;
@@ -194,7 +195,13 @@ struct RollingEpsd {
     }
     const double c_r = eta * 2.0 * std::sqrt(k.i_eff * k_r);
     h.m_roll = m_k;
-    return {m_k - c_r * k.omega_rel, c_r * k.omega_rel * k.omega_rel * dt, half_compliance * m_k * m_k};
+    const double m = m_k - c_r * k.omega_rel;
+    if (std::abs(m) > m_max) {  // spring + dashpot never exceed the cap (physics.md section 3)
+      const double capped = std::copysign(m_max, m);
+      const double stored_change = half_compliance * (m_k * m_k - old.m_roll * old.m_roll);
+      return {capped, -capped * k.omega_rel * dt - stored_change, half_compliance * m_k * m_k};
+    }
+    return {m, c_r * k.omega_rel * k.omega_rel * dt, half_compliance * m_k * m_k};
   }
 };
 

@@ -38,6 +38,7 @@ class PairTable {
   PairTable(const Scene& scene);
   const PairCoeffs& operator()(int a, int b) const { return table_[a * n_ + b]; }
   int n_materials() const { return n_; }
+  const PairCoeffs* data() const { return table_.data(); }  // [a * n_materials() + b]
 
  private:
   int n_ = 0;

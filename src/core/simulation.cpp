@@ -454,8 +454,7 @@ void Simulation::step_iterative() {
 void Simulation::check_stability() {
   const double max_overlap = domain_->max(totals_.max_overlap);
   const bool finite = std::isfinite(domain_->sum(accel_checksum_));
-  constexpr double kMaxOverlap = 0.25;  // of the smaller radius
-  if (finite && max_overlap <= kMaxOverlap) return;
+  if (finite && max_overlap <= kMaxOverlapRatio) return;
   std::ostringstream o;
   o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
   if (!finite) {

@@ -46,6 +46,9 @@ struct TimeScales {
 };
 TimeScales time_scales(const Scene& scene, const ParticleStore& particles);
 
+// A run is unstable when an overlap exceeds this fraction of the smaller radius.
+inline constexpr double kMaxOverlapRatio = 0.25;
+
 struct EvaluationTotals {
   std::int64_t contacts = 0;
   double dissipated = 0.0;   // J in this step

@@ -103,12 +103,18 @@ void Walls::update(double time) {
     b.angle = b.angle0 + ramp_angle(b.speed, b.ramp_time, time);
     b.offset = time * b.velocity;
   }
+  // One rotation per body, applied to its elements.
+  std::vector<Vec2>& cs = rotation_;
+  cs.resize(bodies_.size());
+  for (std::size_t k = 0; k < bodies_.size(); ++k)
+    cs[k] = {std::cos(bodies_[k].angle), std::sin(bodies_[k].angle)};
   for (WallElement& e : elements_) {
     if (e.kind != WallKind::kSegment) continue;
     const WallBody& b = bodies_[e.body];
     const Vec2 origin = b.center + b.offset;
-    e.a = origin + rotate(e.a_ref, b.angle);
-    e.b = origin + rotate(e.b_ref, b.angle);
+    const Vec2 r = cs[e.body];
+    e.a = origin + Vec2{r.x * e.a_ref.x - r.y * e.a_ref.y, r.y * e.a_ref.x + r.x * e.a_ref.y};
+    e.b = origin + Vec2{r.x * e.b_ref.x - r.y * e.b_ref.y, r.y * e.b_ref.x + r.x * e.b_ref.y};
   }
 }
 

@@ -75,6 +75,7 @@ class Walls {
   std::vector<WallElement> elements_;
   int drum_body_ = -1;
   double rotating_reach_ = 0.0;
+  std::vector<Vec2> rotation_;  // (cos, sin) of each body's angle (scratch of update)
 };
 
 // Drum speed and angle at time t for a linear ramp from 0 to `speed` over `ramp` seconds.

@@ -89,7 +89,8 @@ class Diagnostics {
 
   // A value as the deck wrote it when it is on one line there, else formatted.
   std::string shown(const toml::node& node) const {
-    const auto& [begin, end] = std::pair(node.source().begin, node.source().end);
+    const toml::source_position& begin = node.source().begin;
+    const toml::source_position& end = node.source().end;
     if (!origins_.contains(&node) && begin.line > 0 && begin.line == end.line &&
         begin.line <= lines_.size() && end.column > begin.column &&
         end.column - 1 <= lines_[begin.line - 1].size()) {
@@ -113,7 +114,6 @@ class Diagnostics {
   void error_in(std::string_view where, std::string_view message) { add(where, message); }
   void add(std::string complete_message) { messages_.push_back(std::move(complete_message)); }
 
-  const std::string& file() const { return file_; }
   std::vector<std::string>& messages() { return messages_; }
 
  private:
@@ -201,6 +201,8 @@ class TableReader {
     const toml::node* node = find(key);
     diag_.error_at(*node, fmt::format("{} = {}: {}", path_of(key), diag_.shown(*node), what));
   }
+  // The value of `key` as the deck wrote it, for messages about another key.
+  std::string shown(std::string_view key) const { return diag_.shown(*find(key)); }
   void error_at(std::string_view key, std::string_view message) const {
     diag_.error_at(*find(key), message);
   }
@@ -394,8 +396,6 @@ class TableReader {
       diag_.error_at_key(key, value, message);
     }
   }
-
-  Diagnostics& diagnostics() const { return diag_; }
 
  private:
   Diagnostics& diag_;
@@ -655,17 +655,26 @@ class DeckParser {
     return true;
   }
 
+  static std::string_view model_coefficients(ContactModelKind model) {
+    switch (model) {
+      case ContactModelKind::kHertzMindlin:
+        return "restitution";
+      case ContactModelKind::kThesis:
+        return "damping_normal and damping_tangential";
+      case ContactModelKind::kLinear:
+        return "restitution and normal_stiffness";
+    }
+    return "";
+  }
+
   // Reads a model-dependent coefficient, or reports it as not used by the model.
   std::optional<double> model_coefficient(const TableReader& r, std::string_view key,
                                           const Bound& bound) const {
     if (!r.has(key)) return std::nullopt;
     if (!model_takes(key)) {
-      static constexpr std::string_view kTakes[] = {"restitution",
-                                                    "damping_normal and damping_tangential",
-                                                    "restitution and normal_stiffness"};
       r.invalid(key, fmt::format("not used by contact.model = \"{}\", which takes {}",
                                  deck::choice_name(deck::kContactModels, *model_),
-                                 kTakes[static_cast<int>(*model_)]));
+                                 model_coefficients(*model_)));
       return std::nullopt;
     }
     return r.number(key, bound);
@@ -935,7 +944,7 @@ class DeckParser {
       const auto lo = r.number("radius_min", kPositive, Need::kRequired);
       const auto hi = r.number("radius_max", kPositive, Need::kRequired);
       if (lo && hi && *lo > *hi) {
-        r.invalid("radius_min", fmt::format("must be <= radius_max = {}", *hi));
+        r.invalid("radius_min", fmt::format("must be <= radius_max = {}", r.shown("radius_max")));
       } else if (lo && hi) {
         fill.radius_min = *lo;
         fill.radius_max = *hi;
@@ -953,8 +962,8 @@ class DeckParser {
       const auto lo = r.pair("box_min", Need::kRequired);
       const auto hi = r.pair("box_max", Need::kRequired);
       if (lo && hi && !(lo->x < hi->x && lo->y < hi->y)) {
-        r.invalid("box_max", fmt::format("must be above and to the right of box_min = [{}, {}]",
-                                         lo->x, lo->y));
+        r.invalid("box_max", fmt::format("must be above and to the right of box_min = {}",
+                                         r.shown("box_min")));
       } else if (lo && hi) {
         fill.box_min = *lo;
         fill.box_max = *hi;

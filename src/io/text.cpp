@@ -61,9 +61,9 @@ std::string shortest_number(double v) {
   if (zeros < 4) return s;
   const std::string digits = s.substr(sign, last + 1 - sign);
   const std::size_t exponent = zeros + digits.size() - 1;
-  std::string mantissa = digits.substr(0, 1);
-  if (digits.size() > 1) mantissa += "." + digits.substr(1);
-  return fmt::format("{}{}e{}", sign ? "-" : "", mantissa, exponent);
+  const std::string_view fraction = std::string_view(digits).substr(1);  // "" or "1" of "21"
+  return fmt::format("{}{}{}{}e{}", sign ? "-" : "", digits.front(), fraction.empty() ? "" : ".",
+                     fraction, exponent);
 }
 
 }  // namespace

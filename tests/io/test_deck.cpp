@@ -1,0 +1,1155 @@
+// Deck reader and writer (src/io/deck.*, particle_csv.*, run_json.*): every key resolved,
+// defaults, each kind of error with its exact location, --set overrides, CSV packings, the
+// resolved deck read back to the same values, run.json.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "io/deck.hpp"
+#include "io/run_json.hpp"
+
+namespace dem2d {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kPi = std::numbers::pi;
+
+// The messages of the InputError that parsing `text` throws (none: a test failure).
+std::vector<std::string> deck_errors(const std::string& text,
+                                     const std::vector<std::string>& overrides = {},
+                                     const std::string& path = "deck.in") {
+  try {
+    parse_deck_string(text, path, overrides);
+  } catch (const InputError& e) {
+    return e.messages();
+  }
+  ADD_FAILURE() << "expected an InputError for:\n" << text;
+  return {};
+}
+
+::testing::AssertionResult has_message(const std::vector<std::string>& messages,
+                                       const std::string& expected) {
+  for (const auto& m : messages) {
+    if (m == expected) return ::testing::AssertionSuccess();
+  }
+  auto failure = ::testing::AssertionFailure() << "no message\n  " << expected << "\namong\n";
+  for (const auto& m : messages) failure << "  " << m << "\n";
+  return failure;
+}
+
+// A scratch folder per test, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path_ = fs::temp_directory_path() /
+            (std::string("dem2d_test_deck_") + info->name() + "_" + std::to_string(::getpid()));
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~TempDir() { fs::remove_all(path_); }
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path file = path_ / name;
+    std::ofstream(file) << text;
+    return file;
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// A small valid deck: one material, one particle, nothing else.
+const std::string kMinimalDeck = R"(
+[[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+
+[[particle]]
+material = "steel"
+radius = 0.1
+position = [0.0, 0.5]
+)";
+
+// Every table and most keys, with a CSV packing beside it.
+const std::string kFullDeck = R"(title = "Thesis scene: cataracting"
+
+[run]
+duration = 10.0
+dt = 1.0e-5
+integrator = "iterative"
+tolerance = 1.0e-7
+max_passes = 30
+seed = 42
+gravity = [0, -9.81]
+skin = 0.01
+dt_safety = 0.25
+allow_unsafe_dt = true
+
+[contact]
+model = "hertz-mindlin"
+rolling = "constant"
+rolling_damping = 0.4
+
+[[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+poisson_ratio = 0.25
+restitution = 0.73
+sliding_friction = 0.1
+rolling_friction = 0.05
+
+[[material]]
+name = "liner"
+density = 7000
+youngs_modulus = 1.0e11
+shear_modulus = 4.0e10
+
+[[interaction]]
+materials = ["steel", "liner"]
+restitution = 0.6
+sliding_friction = 0.6
+
+[drum]
+radius = 2.5
+center = [0.1, -0.2]
+speed_rpm = 20.0
+ramp_time = 0.5
+sides = 12
+angle = 15.0
+material = "liner"
+
+[[drum.lifter]]
+count = 8
+height = 0.1
+width = 0.05
+angle = 22.5
+material = "steel"
+
+[[fill]]
+material = "steel"
+count = 240
+radius_min = 0.08
+radius_max = 0.12
+region = "box"
+box_min = [-1.0, -2.0]
+box_max = [1.0, 0.0]
+velocity = [0.0, -1.0]
+
+[[fill]]
+material = "steel"
+fill_fraction = 0.2
+radius = 0.1
+region = "annulus"
+
+[[fill]]
+file = "packing.csv"
+material = "steel"
+velocity = [0.5, 0.0]
+
+[[particle]]
+material = "liner"
+radius = 0.2
+position = [0.0, 0.5]
+velocity = [0.0, -2.0]
+spin = 3.0
+
+[[wall]]
+from = [-1.0, 0.0]
+to = [1.0, 0.0]
+material = "steel"
+velocity = [0.1, 0.0]
+
+[output]
+directory = "out/waterfall"
+series_interval = 2.0e-3
+snapshot_interval = 0.05
+checkpoint_interval = 0.0
+progress_interval = 10.0
+)";
+
+const std::string kPackingCsv =
+    "x, y, radius, vy, material\n"
+    "0.0, 0.0, 0.1, 1.5, liner\n"
+    "\n"
+    "# a comment line\n"
+    "0.3, -0.1, 0.05, 0.0,\n";
+
+// Every value of two scenes, except where they came from (deck_path, source lines).
+void expect_same_values(const Scene& a, const Scene& b) {
+  EXPECT_EQ(a.title, b.title);
+  EXPECT_EQ(a.run.duration, b.run.duration);
+  EXPECT_EQ(a.run.dt, b.run.dt);
+  EXPECT_EQ(a.run.dt_auto, b.run.dt_auto);
+  EXPECT_EQ(a.run.integrator, b.run.integrator);
+  EXPECT_EQ(a.run.tolerance, b.run.tolerance);
+  EXPECT_EQ(a.run.max_passes, b.run.max_passes);
+  EXPECT_EQ(a.run.seed, b.run.seed);
+  EXPECT_EQ(a.run.gravity, b.run.gravity);
+  EXPECT_EQ(a.run.skin, b.run.skin);
+  EXPECT_EQ(a.run.dt_safety, b.run.dt_safety);
+  EXPECT_EQ(a.run.allow_unsafe_dt, b.run.allow_unsafe_dt);
+  EXPECT_EQ(a.contact.model, b.contact.model);
+  EXPECT_EQ(a.contact.rolling, b.contact.rolling);
+  EXPECT_EQ(a.contact.rolling_damping, b.contact.rolling_damping);
+  ASSERT_EQ(a.materials.size(), b.materials.size());
+  for (std::size_t i = 0; i < a.materials.size(); ++i) {
+    const MaterialSpec &x = a.materials[i], &y = b.materials[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.density, y.density);
+    EXPECT_EQ(x.youngs_modulus, y.youngs_modulus);
+    EXPECT_EQ(x.poisson_ratio, y.poisson_ratio);
+    EXPECT_EQ(x.shear_modulus, y.shear_modulus);
+    EXPECT_EQ(x.restitution, y.restitution);
+    EXPECT_EQ(x.damping_normal, y.damping_normal);
+    EXPECT_EQ(x.damping_tangential, y.damping_tangential);
+    EXPECT_EQ(x.sliding_friction, y.sliding_friction);
+    EXPECT_EQ(x.rolling_friction, y.rolling_friction);
+    EXPECT_EQ(x.normal_stiffness, y.normal_stiffness);
+  }
+  ASSERT_EQ(a.interactions.size(), b.interactions.size());
+  for (std::size_t i = 0; i < a.interactions.size(); ++i) {
+    const InteractionSpec &x = a.interactions[i], &y = b.interactions[i];
+    EXPECT_EQ(x.material_a, y.material_a);
+    EXPECT_EQ(x.material_b, y.material_b);
+    EXPECT_EQ(x.restitution, y.restitution);
+    EXPECT_EQ(x.sliding_friction, y.sliding_friction);
+    EXPECT_EQ(x.rolling_friction, y.rolling_friction);
+    EXPECT_EQ(x.damping_normal, y.damping_normal);
+    EXPECT_EQ(x.damping_tangential, y.damping_tangential);
+  }
+  EXPECT_EQ(a.drum.present, b.drum.present);
+  EXPECT_EQ(a.drum.radius, b.drum.radius);
+  EXPECT_EQ(a.drum.center, b.drum.center);
+  EXPECT_EQ(a.drum.speed, b.drum.speed);
+  EXPECT_EQ(a.drum.ramp_time, b.drum.ramp_time);
+  EXPECT_EQ(a.drum.sides, b.drum.sides);
+  EXPECT_EQ(a.drum.angle, b.drum.angle);
+  EXPECT_EQ(a.drum.material, b.drum.material);
+  ASSERT_EQ(a.drum.lifters.size(), b.drum.lifters.size());
+  for (std::size_t i = 0; i < a.drum.lifters.size(); ++i) {
+    const LifterSpec &x = a.drum.lifters[i], &y = b.drum.lifters[i];
+    EXPECT_EQ(x.count, y.count);
+    EXPECT_EQ(x.height, y.height);
+    EXPECT_EQ(x.width, y.width);
+    EXPECT_EQ(x.angle, y.angle);
+    EXPECT_EQ(x.material, y.material);
+  }
+  const auto same_fills = [](const std::vector<FillSpec>& fa, const std::vector<FillSpec>& fb) {
+    ASSERT_EQ(fa.size(), fb.size());
+    for (std::size_t i = 0; i < fa.size(); ++i) {
+      const FillSpec &x = fa[i], &y = fb[i];
+      EXPECT_EQ(x.material, y.material);
+      EXPECT_EQ(x.count, y.count);
+      EXPECT_EQ(x.fill_fraction, y.fill_fraction);
+      EXPECT_EQ(x.file, y.file);
+      EXPECT_EQ(x.radius_min, y.radius_min);
+      EXPECT_EQ(x.radius_max, y.radius_max);
+      EXPECT_EQ(x.region, y.region);
+      EXPECT_EQ(x.box_min, y.box_min);
+      EXPECT_EQ(x.box_max, y.box_max);
+      EXPECT_EQ(x.velocity, y.velocity);
+    }
+  };
+  same_fills(a.fills, b.fills);
+  same_fills(a.file_fills, b.file_fills);
+  ASSERT_EQ(a.particles.size(), b.particles.size());
+  for (std::size_t i = 0; i < a.particles.size(); ++i) {
+    const ParticleSpec &x = a.particles[i], &y = b.particles[i];
+    EXPECT_EQ(x.material, y.material);
+    EXPECT_EQ(x.radius, y.radius);
+    EXPECT_EQ(x.position, y.position);
+    EXPECT_EQ(x.velocity, y.velocity);
+    EXPECT_EQ(x.spin, y.spin);
+  }
+  ASSERT_EQ(a.walls.size(), b.walls.size());
+  for (std::size_t i = 0; i < a.walls.size(); ++i) {
+    EXPECT_EQ(a.walls[i].from, b.walls[i].from);
+    EXPECT_EQ(a.walls[i].to, b.walls[i].to);
+    EXPECT_EQ(a.walls[i].material, b.walls[i].material);
+    EXPECT_EQ(a.walls[i].velocity, b.walls[i].velocity);
+  }
+  EXPECT_EQ(a.output.directory, b.output.directory);
+  EXPECT_EQ(a.output.series_interval, b.output.series_interval);
+  EXPECT_EQ(a.output.snapshot_interval, b.output.snapshot_interval);
+  EXPECT_EQ(a.output.checkpoint_interval, b.output.checkpoint_interval);
+  EXPECT_EQ(a.output.progress_interval, b.output.progress_interval);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Valid decks
+
+TEST(Deck, FullDeckResolvesEveryValue) {
+  const TempDir dir;
+  dir.write("packing.csv", kPackingCsv);
+  const fs::path deck = dir.write("full.in", kFullDeck);
+  const Scene s = load_deck(deck.string());
+
+  EXPECT_EQ(s.deck_path, deck.string());
+  EXPECT_EQ(s.title, "Thesis scene: cataracting");
+  EXPECT_EQ(s.run.duration, 10.0);
+  EXPECT_FALSE(s.run.dt_auto);
+  EXPECT_EQ(s.run.dt, 1.0e-5);
+  EXPECT_EQ(s.run.integrator, IntegratorKind::kIterative);
+  EXPECT_EQ(s.run.tolerance, 1.0e-7);
+  EXPECT_EQ(s.run.max_passes, 30);
+  EXPECT_EQ(s.run.seed, 42u);
+  EXPECT_EQ(s.run.gravity, (Vec2{0.0, -9.81}));  // an integer accepted as a float
+  EXPECT_EQ(s.run.skin, 0.01);
+  EXPECT_EQ(s.run.dt_safety, 0.25);
+  EXPECT_TRUE(s.run.allow_unsafe_dt);
+  EXPECT_EQ(s.contact.model, ContactModelKind::kHertzMindlin);
+  EXPECT_EQ(s.contact.rolling, RollingModelKind::kConstant);
+  EXPECT_EQ(s.contact.rolling_damping, 0.4);
+
+  ASSERT_EQ(s.materials.size(), 2u);
+  const MaterialSpec& steel = s.materials[0];
+  EXPECT_EQ(steel.name, "steel");
+  EXPECT_EQ(steel.density, 7800.0);
+  EXPECT_EQ(steel.youngs_modulus, 2.0e11);
+  EXPECT_EQ(steel.poisson_ratio, 0.25);
+  EXPECT_DOUBLE_EQ(steel.shear_modulus, 8.0e10);  // G = E / (2 (1 + nu))
+  EXPECT_EQ(steel.restitution, 0.73);
+  EXPECT_EQ(steel.sliding_friction, 0.1);
+  EXPECT_EQ(steel.rolling_friction, 0.05);
+  const MaterialSpec& liner = s.materials[1];
+  EXPECT_EQ(liner.density, 7000.0);
+  EXPECT_EQ(liner.shear_modulus, 4.0e10);
+  EXPECT_DOUBLE_EQ(liner.poisson_ratio, 0.25);  // nu = E / (2 G) - 1
+  EXPECT_EQ(liner.restitution, 0.5);            // default
+
+  ASSERT_EQ(s.interactions.size(), 1u);
+  EXPECT_EQ(s.interactions[0].material_a, "steel");
+  EXPECT_EQ(s.interactions[0].material_b, "liner");
+  EXPECT_EQ(s.interactions[0].restitution, 0.6);
+  EXPECT_EQ(s.interactions[0].sliding_friction, 0.6);
+  EXPECT_FALSE(s.interactions[0].rolling_friction.has_value());
+
+  EXPECT_TRUE(s.drum.present);
+  EXPECT_EQ(s.drum.radius, 2.5);
+  EXPECT_EQ(s.drum.center, (Vec2{0.1, -0.2}));
+  EXPECT_DOUBLE_EQ(s.drum.speed, 20.0 * 2.0 * kPi / 60.0);  // rpm -> rad/s
+  EXPECT_EQ(s.drum.ramp_time, 0.5);
+  EXPECT_EQ(s.drum.sides, 12);
+  EXPECT_DOUBLE_EQ(s.drum.angle, kPi / 12.0);  // 15 degrees
+  EXPECT_EQ(s.drum.material, "liner");
+  ASSERT_EQ(s.drum.lifters.size(), 1u);
+  EXPECT_EQ(s.drum.lifters[0].count, 8);
+  EXPECT_EQ(s.drum.lifters[0].height, 0.1);
+  EXPECT_EQ(s.drum.lifters[0].width, 0.05);
+  EXPECT_DOUBLE_EQ(s.drum.lifters[0].angle, kPi / 8.0);  // 22.5 degrees
+  EXPECT_EQ(s.drum.lifters[0].material, "steel");
+
+  ASSERT_EQ(s.fills.size(), 2u);  // the file fill is not among them
+  EXPECT_EQ(s.fills[0].count, 240);
+  EXPECT_EQ(s.fills[0].radius_min, 0.08);
+  EXPECT_EQ(s.fills[0].radius_max, 0.12);
+  EXPECT_EQ(s.fills[0].region, FillRegion::kBox);
+  EXPECT_EQ(s.fills[0].box_min, (Vec2{-1.0, -2.0}));
+  EXPECT_EQ(s.fills[0].box_max, (Vec2{1.0, 0.0}));
+  EXPECT_EQ(s.fills[0].velocity, (Vec2{0.0, -1.0}));
+  EXPECT_EQ(s.fills[0].source_line, 56);  // the [[fill]] header
+  EXPECT_EQ(s.fills[1].fill_fraction, 0.2);
+  EXPECT_EQ(s.fills[1].count, 0);
+  EXPECT_EQ(s.fills[1].radius_min, 0.1);
+  EXPECT_EQ(s.fills[1].radius_max, 0.1);
+  EXPECT_EQ(s.fills[1].region, FillRegion::kAnnulus);
+
+  ASSERT_EQ(s.file_fills.size(), 1u);
+  EXPECT_EQ(s.file_fills[0].file, fs::absolute(dir.path() / "packing.csv").string());
+  EXPECT_EQ(s.file_fills[0].count, 2);
+
+  // The [[particle]] first, then the CSV rows.
+  ASSERT_EQ(s.particles.size(), 3u);
+  EXPECT_EQ(s.particles[0].material, "liner");
+  EXPECT_EQ(s.particles[0].radius, 0.2);
+  EXPECT_EQ(s.particles[0].position, (Vec2{0.0, 0.5}));
+  EXPECT_EQ(s.particles[0].velocity, (Vec2{0.0, -2.0}));
+  EXPECT_EQ(s.particles[0].spin, 3.0);
+  EXPECT_EQ(s.particles[0].source_line, 77);
+  EXPECT_EQ(s.particles[1].material, "liner");  // from the material column
+  EXPECT_EQ(s.particles[1].position, (Vec2{0.0, 0.0}));
+  EXPECT_EQ(s.particles[1].radius, 0.1);
+  EXPECT_EQ(s.particles[1].velocity, (Vec2{0.5, 1.5}));  // vx from the fill, vy from the file
+  EXPECT_EQ(s.particles[1].source_line, 2);
+  EXPECT_EQ(s.particles[2].material, "steel");  // empty field: the fill's material
+  EXPECT_EQ(s.particles[2].position, (Vec2{0.3, -0.1}));
+  EXPECT_EQ(s.particles[2].radius, 0.05);
+  EXPECT_EQ(s.particles[2].source_line, 5);
+
+  ASSERT_EQ(s.walls.size(), 1u);
+  EXPECT_EQ(s.walls[0].from, (Vec2{-1.0, 0.0}));
+  EXPECT_EQ(s.walls[0].to, (Vec2{1.0, 0.0}));
+  EXPECT_EQ(s.walls[0].velocity, (Vec2{0.1, 0.0}));
+
+  EXPECT_EQ(s.output.directory, "out/waterfall");
+  EXPECT_EQ(s.output.series_interval, 2.0e-3);
+  EXPECT_EQ(s.output.snapshot_interval, 0.05);
+  EXPECT_EQ(s.output.checkpoint_interval, 0.0);
+  EXPECT_EQ(s.output.progress_interval, 10.0);
+}
+
+TEST(Deck, DefaultsAreFilledIn) {
+  const Scene s = parse_deck_string(kMinimalDeck, "min.in");
+  EXPECT_EQ(s.title, "");
+  EXPECT_EQ(s.run.duration, 1.0);
+  EXPECT_TRUE(s.run.dt_auto);
+  EXPECT_EQ(s.run.dt, 0.0);
+  EXPECT_EQ(s.run.integrator, IntegratorKind::kVerlet);
+  EXPECT_EQ(s.run.tolerance, 1.0e-6);
+  EXPECT_EQ(s.run.max_passes, 20);
+  EXPECT_EQ(s.run.seed, 1u);
+  EXPECT_EQ(s.run.gravity, (Vec2{0.0, -9.81}));
+  EXPECT_EQ(s.run.skin, -1.0);  // the core chooses
+  EXPECT_EQ(s.run.dt_safety, 0.2);
+  EXPECT_FALSE(s.run.allow_unsafe_dt);
+  EXPECT_EQ(s.contact.model, ContactModelKind::kHertzMindlin);
+  EXPECT_EQ(s.contact.rolling, RollingModelKind::kEpsd);
+  EXPECT_EQ(s.contact.rolling_damping, 0.3);
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[0].poisson_ratio, 0.25);
+  EXPECT_DOUBLE_EQ(s.materials[0].shear_modulus, 8.0e10);
+  EXPECT_EQ(s.materials[0].restitution, 0.5);
+  EXPECT_EQ(s.materials[0].sliding_friction, 0.5);
+  EXPECT_EQ(s.materials[0].rolling_friction, 0.0);
+  EXPECT_EQ(s.materials[0].normal_stiffness, 0.0);
+  EXPECT_FALSE(s.drum.present);
+  EXPECT_TRUE(s.fills.empty());
+  ASSERT_EQ(s.particles.size(), 1u);
+  EXPECT_EQ(s.particles[0].velocity, (Vec2{0.0, 0.0}));
+  EXPECT_EQ(s.particles[0].spin, 0.0);
+  EXPECT_EQ(s.particles[0].source_line, 7);
+  EXPECT_EQ(s.output.directory, "out");
+  EXPECT_EQ(s.output.series_interval, 1.0e-3);
+  EXPECT_EQ(s.output.snapshot_interval, 0.0);
+  EXPECT_EQ(s.output.checkpoint_interval, 0.0);
+  EXPECT_EQ(s.output.progress_interval, 5.0);
+}
+
+TEST(Deck, DrumSpeedFromCriticalFraction) {
+  // w = f sqrt(|g| / R), the classical critical speed of a point on the shell.
+  const Scene s = parse_deck_string(kMinimalDeck + R"(
+[drum]
+radius = 2.5
+critical_fraction = 0.75
+material = "steel"
+)",
+                                    "deck.in", {"run.gravity=[3.0, -4.0]"});
+  EXPECT_DOUBLE_EQ(s.drum.speed, 0.75 * std::sqrt(5.0 / 2.5));
+  EXPECT_EQ(s.drum.sides, 0);
+  EXPECT_EQ(s.drum.angle, 0.0);
+}
+
+TEST(Deck, ThesisAndLinearModelsTakeTheirCoefficients) {
+  const Scene thesis = parse_deck_string(R"(
+[contact]
+model = "thesis"
+rolling = "none"
+[[material]]
+name = "ore"
+density = 4800
+youngs_modulus = 6.0e10
+damping_normal = 0.2
+damping_tangential = 0.3
+)" + kMinimalDeck.substr(kMinimalDeck.find("[[particle]]")),
+                                         "deck.in", {"particle.0.material=ore"});
+  EXPECT_EQ(thesis.contact.model, ContactModelKind::kThesis);
+  EXPECT_EQ(thesis.contact.rolling, RollingModelKind::kNone);
+  EXPECT_EQ(thesis.materials[0].damping_normal, 0.2);
+  EXPECT_EQ(thesis.materials[0].damping_tangential, 0.3);
+
+  const Scene linear = parse_deck_string(
+      kMinimalDeck, "deck.in", {"contact.model=linear", "material.steel.normal_stiffness=1e6"});
+  EXPECT_EQ(linear.materials[0].normal_stiffness, 1.0e6);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors: each with its exact location and key
+
+TEST(DeckErrors, MissingFile) {
+  try {
+    load_deck("/nonexistent/deck.in");
+    FAIL() << "no InputError";
+  } catch (const InputError& e) {
+    ASSERT_EQ(e.messages().size(), 1u);
+    EXPECT_EQ(e.messages()[0],
+              "/nonexistent/deck.in: error: cannot open deck: No such file or directory");
+  }
+}
+
+TEST(DeckErrors, TomlSyntaxErrorHasItsPosition) {
+  const auto messages = deck_errors("[run]\nduration = 1.0\ndt = [1.0,\n");
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0], "deck.in:3:12: error: Error while parsing array: encountered end-of-file");
+
+  const auto twice = deck_errors("[run]\nduration = 1.0\nduration = 2.0\n");
+  ASSERT_EQ(twice.size(), 1u);
+  EXPECT_EQ(twice[0],
+            "deck.in:3:12: error: Error while parsing key-value pair: cannot redefine "
+            "existing floating-point 'duration'");
+}
+
+TEST(DeckErrors, OutOfRangeValue) {
+  const auto messages = deck_errors(R"(
+[run]
+duration = -1
+dt_safety = 1.5
+)" + kMinimalDeck);
+  EXPECT_TRUE(has_message(messages, "deck.in:3:12: error: run.duration = -1: must be > 0"));
+  EXPECT_TRUE(has_message(messages, "deck.in:4:13: error: run.dt_safety = 1.5: must be in (0, 1]"));
+  EXPECT_EQ(messages.size(), 2u);
+}
+
+TEST(DeckErrors, WrongTypes) {
+  const auto messages = deck_errors(R"(title = 3
+[run]
+dt = "fast"
+max_passes = 2.5
+gravity = [0.0, -9.81, 0.0]
+allow_unsafe_dt = "yes"
+)" + kMinimalDeck);
+  EXPECT_TRUE(has_message(messages, "deck.in:1:9: error: title = 3: expected a string"));
+  EXPECT_TRUE(has_message(
+      messages, "deck.in:3:6: error: run.dt = \"fast\": expected a number > 0 (s) or \"auto\""));
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:4:14: error: run.max_passes = 2.5: expected an integer >= 1"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:5:11: error: run.gravity = [0.0, -9.81, 0.0]: "
+                          "expected an array of two numbers [x, y]"));
+  EXPECT_TRUE(has_message(
+      messages, "deck.in:6:19: error: run.allow_unsafe_dt = \"yes\": expected true or false"));
+  EXPECT_EQ(messages.size(), 5u);
+}
+
+TEST(DeckErrors, ChoiceListsTheAllowedWords) {
+  const auto messages =
+      deck_errors("[contact]\nmodel = \"hertz\"\nrolling = \"EPSD\"\n" + kMinimalDeck);
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:2:9: error: contact.model = \"hertz\": must be one "
+                          "of \"hertz-mindlin\", \"thesis\", \"linear\""));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:3:11: error: contact.rolling = \"EPSD\": must be one of "
+                          "\"epsd\", \"constant\", \"none\"; did you mean \"epsd\"?"));
+}
+
+TEST(DeckErrors, MisspeltKeySuggestsTheRightOne) {
+  const auto messages = deck_errors(R"(
+[[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+restituion = 0.7
+
+[runn]
+duration = 1.0
+
+[[particle]]
+material = "steel"
+radius = 0.1
+position = [0.0, 0.5]
+veloctiy = [1.0, 0.0]
+colour = "red"
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:6:1: error: unknown key 'restituion' in "
+                          "[[material]]; did you mean 'restitution'?"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:8:2: error: unknown table [runn]; did you mean "
+                          "[run]?"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:15:1: error: unknown key 'veloctiy' in "
+                          "[[particle]]; did you mean 'velocity'?"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:16:1: error: unknown key 'colour' in [[particle]]; "
+                          "valid keys: material, radius, position, velocity, spin"));
+  EXPECT_EQ(messages.size(), 4u);
+}
+
+TEST(DeckErrors, MissingRequiredKeyIsReportedAtTheTable) {
+  const auto messages = deck_errors(R"(
+[[material]]
+name = "steel"
+youngs_modulus = 2.0e11
+
+[[particle]]
+material = "steel"
+position = [0.0, 0.5]
+)");
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:2:1: error: material[0].density is required (a number > 0)"));
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:6:1: error: particle[0].radius is required (a number > 0)"));
+  EXPECT_EQ(messages.size(), 2u);
+}
+
+TEST(DeckErrors, UnknownMaterialListsTheDefinedOnes) {
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[[material]]
+name = "liner"
+density = 7000.0
+youngs_modulus = 1.0e11
+
+[[wall]]
+from = [-1.0, 0.0]
+to = [1.0, 0.0]
+material = "stell"
+
+[[interaction]]
+materials = ["steel", "rubber"]
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:20:12: error: wall[0].material = \"stell\": no such "
+                          "material; did you mean \"steel\"? (defined: \"steel\", "
+                          "\"liner\")"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:23:23: error: interaction[0].materials[1] = "
+                          "\"rubber\": no such material (defined: \"steel\", "
+                          "\"liner\")"));
+  EXPECT_EQ(messages.size(), 2u);
+}
+
+TEST(DeckErrors, MaterialElasticity) {
+  const auto messages = deck_errors(R"(
+[[material]]
+name = "a"
+density = 1.0
+youngs_modulus = 1.0e9
+poisson_ratio = 0.3
+shear_modulus = 4.0e8
+
+[[material]]
+name = "b"
+density = 1.0
+youngs_modulus = 1.0e9
+shear_modulus = 1.0e8
+
+[[material]]
+name = "a"
+density = 1.0
+youngs_modulus = 1.0e9
+poisson_ratio = 0.5
+
+[[particle]]
+material = "a"
+radius = 0.1
+position = [0.0, 0.0]
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:7:17: error: material[0]: give poisson_ratio or "
+                          "shear_modulus, not both"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:13:17: error: material[1].shear_modulus = 1.0e8: "
+                          "gives poisson_ratio = youngs_modulus / (2 shear_modulus) - "
+                          "1 = 4, which must be in [-1, 0.5) (shear_modulus > "
+                          "333333333.3333333)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:16:8: error: material[2].name = \"a\": already the "
+                          "name of material[0]"));
+  EXPECT_TRUE(has_message(
+      messages, "deck.in:19:17: error: material[2].poisson_ratio = 0.5: must be in [0, 0.5)"));
+  EXPECT_EQ(messages.size(), 4u);
+}
+
+TEST(DeckErrors, CoefficientOfAnotherContactModel) {
+  const auto messages = deck_errors(R"(
+[contact]
+model = "thesis"
+
+[[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+restitution = 0.7
+normal_stiffness = 1e6
+)" + kMinimalDeck.substr(kMinimalDeck.find("[[particle]]")));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:9:15: error: material[0].restitution = 0.7: not "
+                          "used by contact.model = \"thesis\", which takes "
+                          "damping_normal and damping_tangential"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:10:20: error: material[0].normal_stiffness = 1e6: "
+                          "not used by contact.model = \"thesis\", which takes "
+                          "damping_normal and damping_tangential"));
+  EXPECT_EQ(messages.size(), 2u);
+}
+
+TEST(DeckErrors, DrumKeys) {
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[drum]
+radius = 2.5
+speed = 1.0
+speed_rpm = 10.0
+sides = 2
+ramp_time = -1.0
+material = "steel"
+
+[[drum.lifter]]
+count = 0
+height = 3.0
+width = 0.1
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:15:13: error: drum: give only one of speed, "
+                          "speed_rpm and critical_fraction (found speed and "
+                          "speed_rpm)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:16:9: error: drum.sides = 2: must be 0 (a circle) "
+                          "or >= 3 (a regular polygon)"));
+  EXPECT_TRUE(has_message(messages, "deck.in:17:13: error: drum.ramp_time = -1.0: must be >= 0"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:21:9: error: drum.lifter[0].count = 0: must be >= "
+                          "1"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:22:10: error: drum.lifter[0].height = 3.0: must be "
+                          "< drum.radius = 2.5"));
+  EXPECT_EQ(messages.size(), 5u);
+}
+
+TEST(DeckErrors, FillKeys) {
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[[fill]]
+material = "steel"
+count = 10
+fill_fraction = 0.3
+radius = 0.1
+
+[[fill]]
+material = "steel"
+fill_fraction = 0.3
+radius_min = 0.2
+radius_max = 0.1
+region = "box"
+box_min = [0.0, 0.0]
+box_max = [1.0, 0.0]
+
+[[fill]]
+material = "steel"
+count = 5
+radius = 0.1
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:12:1: error: fill[0]: give only one of count, "
+                          "fill_fraction and file (found count and fill_fraction)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:15:17: error: fill[0].fill_fraction = 0.3: needs "
+                          "a [drum] (it is a fraction of the drum's area)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:21:14: error: fill[1].radius_min = 0.2: must be <= "
+                          "radius_max = 0.1"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:25:11: error: fill[1].box_max = [1.0, 0.0]: must be "
+                          "above and to the right of box_min = [0.0, 0.0]"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:27:1: error: fill[2]: the default region "
+                          "\"bottom\" needs a [drum]; without one, use region = "
+                          "\"box\" with box_min and box_max"));
+  // Also: fill[1].fill_fraction needs a drum, and so does fill[0]'s default region.
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:20:17: error: fill[1].fill_fraction = 0.3: needs "
+                          "a [drum] (it is a fraction of the drum's area)"));
+  EXPECT_EQ(messages.size(), 7u);
+}
+
+TEST(DeckErrors, WallsAndOutput) {
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[[wall]]
+from = [1.0, 1.0]
+to = [1, 1]
+material = "steel"
+
+[output]
+checkpoint_interval = 1.0
+series_interval = 0
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:14:6: error: wall[0].to = [1, 1]: must differ from "
+                          "wall.from (a wall has a length)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:18:23: error: output.checkpoint_interval = 1.0: "
+                          "checkpoints are not implemented yet; use 0"));
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:19:19: error: output.series_interval = 0: must be > 0"));
+  EXPECT_EQ(messages.size(), 3u);
+}
+
+TEST(DeckErrors, NoPositionForTheDeckAsAWhole) {
+  const auto messages = deck_errors("title = \"empty\"\n");
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0], "deck.in: error: no particles: add a [[fill]] or a [[particle]] table");
+
+  const auto no_material = deck_errors(
+      "[[particle]]\nmaterial = \"steel\"\nradius = 0.1\n"
+      "position = [0.0, 0.0]\n");
+  ASSERT_EQ(no_material.size(), 1u);
+  EXPECT_EQ(no_material[0],
+            "deck.in: error: no [[material]] is defined; every [[fill]], "
+            "[[particle]], [[wall]] and the [drum] name one");
+}
+
+TEST(DeckErrors, TablesOfTheWrongKind) {
+  const auto messages = deck_errors(R"(
+run = 5
+[material]
+name = "steel"
+[[drum]]
+radius = 1.0
+)");
+  EXPECT_TRUE(has_message(messages, "deck.in:2:7: error: run = 5: expected a table [run]"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:3:1: error: material: expected an array of "
+                          "tables: write [[material]], not [material]"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:5:1: error: drum: expected one table [drum], not "
+                          "an array of tables [[drum]]"));
+}
+
+TEST(DeckErrors, AllErrorsAreReportedInOneThrow) {
+  const auto messages = deck_errors(R"(
+[run]
+duration = 0.0
+integrator = "euler"
+
+[[material]]
+name = "steel"
+density = -7800.0
+youngs_modulus = 2.0e11
+sliding_fricton = 0.1
+
+[[particle]]
+material = "steel"
+radius = -0.1
+position = [0.0]
+)");
+  ASSERT_EQ(messages.size(), 6u);
+  EXPECT_TRUE(has_message(messages, "deck.in:3:12: error: run.duration = 0.0: must be > 0"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:4:14: error: run.integrator = \"euler\": must be "
+                          "one of \"verlet\", \"iterative\""));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:8:11: error: material[0].density = -7800.0: must "
+                          "be > 0"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:10:1: error: unknown key 'sliding_fricton' in "
+                          "[[material]]; did you mean 'sliding_friction'?"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:14:10: error: particle[0].radius = -0.1: must be "
+                          "> 0"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:15:12: error: particle[0].position = [0.0]: "
+                          "expected an array of two numbers [x, y]"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// --set overrides
+
+TEST(DeckOverrides, ByDottedPathNameAndIndex) {
+  const Scene s =
+      parse_deck_string(kMinimalDeck + R"(
+[[material]]
+name = "liner"
+density = 7000.0
+youngs_modulus = 1.0e11
+
+[drum]
+radius = 2.5
+speed = 1.0
+material = "liner"
+
+[[drum.lifter]]
+count = 4
+height = 0.1
+width = 0.1
+
+[[fill]]
+material = "steel"
+count = 10
+radius = 0.1
+)",
+                        "deck.in",
+                        {"drum.speed=1.5", "run.dt=auto", "run.duration = 2",
+                         "material.liner.restitution=0.4", "material.0.density=5000",
+                         "fill.0.count=100", "drum.lifter.0.height=0.2", "run.gravity=[0, -1.5]",
+                         "title=sweep 3", "output.directory='runs/a b'", "fill.0.region=full"});
+  EXPECT_EQ(s.drum.speed, 1.5);
+  EXPECT_TRUE(s.run.dt_auto);
+  EXPECT_EQ(s.run.duration, 2.0);
+  EXPECT_EQ(s.materials[1].restitution, 0.4);
+  EXPECT_EQ(s.materials[0].density, 5000.0);
+  EXPECT_EQ(s.fills[0].count, 100);
+  EXPECT_EQ(s.fills[0].region, FillRegion::kFull);
+  EXPECT_EQ(s.drum.lifters[0].height, 0.2);
+  EXPECT_EQ(s.run.gravity, (Vec2{0.0, -1.5}));
+  EXPECT_EQ(s.title, "sweep 3");  // not one TOML value: a bare string
+  EXPECT_EQ(s.output.directory, "runs/a b");
+
+  // A later --set of the same key wins.
+  const Scene twice = parse_deck_string(kMinimalDeck, "deck.in", {"run.seed=3", "run.seed=4"});
+  EXPECT_EQ(twice.run.seed, 4u);
+}
+
+TEST(DeckOverrides, ErrorsNameTheOption) {
+  const auto messages =
+      deck_errors(kMinimalDeck + R"(
+[drum]
+radius = 2.5
+material = "steel"
+)",
+                  {"drum.sped=1.5", "drum.radius=-1", "material.stel.density=1",
+                   "particle.3.radius=1", "run.dt", "contact.model=hertz", "drum.radius.x=1",
+                   "wall.0.from=[0, 0]", "material=1", "nonsense.key=1"});
+  EXPECT_TRUE(has_message(messages,
+                          "--set drum.sped=1.5: error: unknown key 'sped' in [drum]; "
+                          "did you mean 'speed'?"));
+  EXPECT_TRUE(has_message(messages, "--set drum.radius=-1: error: drum.radius = -1: must be > 0"));
+  EXPECT_TRUE(has_message(messages,
+                          "--set material.stel.density=1: error: no [[material]] "
+                          "element 'stel'; give an index 0 to 0 or a name: \"steel\""));
+  EXPECT_TRUE(has_message(messages,
+                          "--set particle.3.radius=1: error: no [[particle]] element "
+                          "'3'; give an index 0 to 0"));
+  EXPECT_TRUE(
+      has_message(messages, "--set run.dt: error: expected KEY=VALUE, e.g. drum.speed=1.5"));
+  EXPECT_TRUE(has_message(messages,
+                          "--set contact.model=hertz: error: contact.model = "
+                          "\"hertz\": must be one of \"hertz-mindlin\", \"thesis\", "
+                          "\"linear\""));
+  EXPECT_TRUE(
+      has_message(messages, "--set drum.radius.x=1: error: drum.radius is a value, not a table"));
+  EXPECT_TRUE(
+      has_message(messages, "--set wall.0.from=[0, 0]: error: the deck has no [[wall]] table"));
+  EXPECT_TRUE(has_message(messages,
+                          "--set material=1: error: cannot set all of [[material]]; "
+                          "set one key of one element: material.INDEX.KEY"));
+  EXPECT_TRUE(has_message(messages,
+                          "--set nonsense.key=1: error: unknown table [nonsense]; "
+                          "valid keys: title, run, contact, material, interaction, "
+                          "drum, fill, particle, wall, output"));
+  EXPECT_EQ(messages.size(), 10u);
+}
+
+TEST(DeckOverrides, OverrideCanCreateATable) {
+  const Scene s =
+      parse_deck_string(kMinimalDeck, "deck.in", {"drum.radius=2", "drum.material=steel"});
+  EXPECT_TRUE(s.drum.present);
+  EXPECT_EQ(s.drum.radius, 2.0);
+  EXPECT_EQ(s.drum.material, "steel");
+
+  // A table made by --set is located at the option that made it.
+  const auto messages = deck_errors(kMinimalDeck, {"drum.radius=2"});
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0], "--set drum.radius=2: error: drum.material is required (a string)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// CSV packings
+
+TEST(DeckCsv, ErrorsCarryTheFileLine) {
+  const TempDir dir;
+  dir.write("bad.csv",
+            "x,y,radius,material\n"
+            "0.0,0.0,0.1,steel\n"
+            "abc,0.0,0.1,steel\n"
+            "0.0,0.0,-0.1,steel\n"
+            "0.0,0.0,0.1,stel\n"
+            "0.0,0.0\n");
+  dir.write("header.csv", "x,y,raduis\n0,0,0.1\n");
+  dir.write("nomaterial.csv", "x,y,radius\n0,0,0.1\n");
+  const fs::path deck = dir.write("deck.in", kMinimalDeck + R"(
+[[fill]]
+file = "bad.csv"
+
+[[fill]]
+file = "header.csv"
+material = "steel"
+
+[[fill]]
+file = "nomaterial.csv"
+
+[[fill]]
+file = "missing.csv"
+material = "steel"
+)");
+  std::vector<std::string> messages;
+  try {
+    load_deck(deck.string());
+  } catch (const InputError& e) {
+    messages = e.messages();
+  }
+  const std::string d = deck.string();
+  const std::string bad = (dir.path() / "bad.csv").string();
+  EXPECT_TRUE(has_message(messages, bad + ":3: error: column 'x' = \"abc\": expected a number"));
+  EXPECT_TRUE(has_message(messages, bad + ":4: error: column 'radius' = -0.1: must be > 0"));
+  EXPECT_TRUE(has_message(messages, bad + ":5: error: column 'material' = \"stel\": no such "
+                                          "material; did you mean \"steel\"? (defined: "
+                                          "\"steel\")"));
+  EXPECT_TRUE(has_message(messages, bad + ":6: error: 2 fields, expected 4 as in the header"));
+  EXPECT_TRUE(has_message(messages, (dir.path() / "header.csv").string() +
+                                        ":1: error: unknown column 'raduis'; did you mean "
+                                        "'radius'? (columns: x, y, radius, vx, vy, spin, "
+                                        "material)"));
+  EXPECT_TRUE(has_message(messages, d + ":19:1: error: fill[2].material is required: " +
+                                        (dir.path() / "nomaterial.csv").string() +
+                                        " has no material column"));
+  EXPECT_TRUE(has_message(messages, d +
+                                        ":23:8: error: fill[3].file = \"missing.csv\": cannot "
+                                        "open " +
+                                        (dir.path() / "missing.csv").string() +
+                                        ": No such file or directory"));
+  EXPECT_EQ(messages.size(), 7u);
+}
+
+TEST(DeckCsv, FileFillRejectsPlacementKeys) {
+  const TempDir dir;
+  dir.write("p.csv", "x,y,radius\n0,0,0.1\n");
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[[fill]]
+file = "p.csv"
+material = "steel"
+radius = 0.1
+)",
+                                    {}, (dir.path() / "deck.in").string());
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0], (dir.path() / "deck.in").string() +
+                             ":15:10: error: fill[0].radius = 0.1: not used by a fill from a "
+                             "file (the file gives each particle)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Resolved deck and run.json
+
+// parse(resolved(parse(x))) has the values of parse(x), bit for bit.
+void expect_round_trip(const TempDir& dir, const std::string& text,
+                       const std::vector<std::string>& overrides = {}) {
+  const Scene first = load_deck(dir.write("original.in", text).string(), overrides);
+  const std::string resolved = resolved_deck_toml(first);
+  SCOPED_TRACE(resolved);
+  Scene second;
+  try {
+    second = load_deck(dir.write("resolved.in", resolved).string());
+  } catch (const InputError& e) {
+    FAIL() << e.what();
+  }
+  expect_same_values(first, second);
+  EXPECT_EQ(resolved_deck_toml(second), resolved);
+}
+
+TEST(DeckResolved, ReadsBackToTheSameValues) {
+  const TempDir dir;
+  dir.write("packing.csv", kPackingCsv);
+  expect_round_trip(dir, kFullDeck);
+  // Angles and speeds that do not convert exactly, a random seed, a fraction of the area.
+  expect_round_trip(dir, kFullDeck,
+                    {"drum.angle=33.3", "drum.lifter.0.angle=-7.1", "drum.ramp_time=0.1",
+                     "run.seed=9007199254740993", "fill.1.fill_fraction=0.37"});
+}
+
+TEST(DeckResolved, ReadsBackOtherModelsAndDerivedValues) {
+  const TempDir dir;
+  // Thesis model, shear modulus given, critical fraction, dt = "auto", lifter of the drum's
+  // material, no interactions, a box fill with a radius range.
+  expect_round_trip(dir, R"(
+[run]
+dt = "auto"
+gravity = [0.3, -9.7]
+[contact]
+model = "thesis"
+rolling = "none"
+[[material]]
+name = "ore"
+density = 4800.0
+youngs_modulus = 6.0e10
+shear_modulus = 2.4e10
+damping_normal = 0.1
+damping_tangential = 0.12
+sliding_friction = 0.3
+[drum]
+radius = 1.7
+critical_fraction = 0.65
+sides = 7
+angle = -12.34
+material = "ore"
+[[drum.lifter]]
+count = 3
+height = 0.05
+width = 0.02
+angle = 1.0e-3
+[[fill]]
+material = "ore"
+count = 50
+radius_min = 0.01
+radius_max = 0.03
+region = "box"
+box_min = [-0.5, -1.0]
+box_max = [0.5, -0.2]
+[[wall]]
+from = [0, 0]
+to = [0.1, 0.3]
+material = "ore"
+)");
+  // Linear model with a stiffness, and a speed in rpm.
+  expect_round_trip(dir, kMinimalDeck + R"(
+[contact]
+model = "linear"
+[drum]
+radius = 0.3
+speed_rpm = 17.3
+material = "steel"
+)",
+                    {"material.steel.normal_stiffness=3.3e5", "material.steel.restitution=0.9"});
+}
+
+TEST(DeckResolved, WritesEveryDefault) {
+  const std::string resolved = resolved_deck_toml(parse_deck_string(kMinimalDeck, "min.in"));
+  for (const char* line :
+       {"dt = \"auto\"", "integrator = \"verlet\"", "gravity = [0.0, -9.81]",
+        "model = \"hertz-mindlin\"", "rolling = \"epsd\"", "poisson_ratio = 0.25",
+        "restitution = 0.5", "youngs_modulus = 2e11", "velocity = [0.0, 0.0]",
+        "directory = \"out\"", "series_interval = 0.001", "checkpoint_interval = 0.0"}) {
+    EXPECT_NE(resolved.find(std::string("\n") + line + "\n"), std::string::npos) << line;
+  }
+  EXPECT_EQ(resolved.find("skin"), std::string::npos);  // unset: the core chooses
+  EXPECT_EQ(resolved.find("[drum]"), std::string::npos);
+}
+
+TEST(RunJson, HoldsTheRunAndTheResolvedDeck) {
+  const TempDir dir;
+  const Scene scene = parse_deck_string(kMinimalDeck, "min.in", {"title=a \"quoted\" title"});
+  RunInfo info;
+  info.version = "0.1.0";
+  info.ranks = 3;
+  info.wall_time_s = 12.5;
+  info.steps = 1000;
+  info.particle_steps_per_second = 2.0e6;
+  info.dt = 1.0e-5;
+  info.extra = {{"final_time", "0.01"}};
+  const fs::path path = dir.path() / "run.json";
+  write_run_json(path.string(), scene, info);
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string json = buffer.str();
+  for (const char* part :
+       {"\"version\": \"0.1.0\",", "\"ranks\": 3,", "\"wall_time_s\": 12.5,", "\"steps\": 1000,",
+        "\"particle_steps_per_second\": 2e6,", "\"dt\": 1e-5,", "\"final_time\": 0.01,",
+        "\"deck\": {", "\"title\": \"a \\\"quoted\\\" title\"", "\"dt\": \"auto\"",
+        "\"material\": [{", "\"gravity\": [0, -9.81]", "\"interaction\": []"}) {
+    EXPECT_NE(json.find(part), std::string::npos) << part << "\n" << json;
+  }
+  EXPECT_FALSE(fs::exists(path.string() + ".tmp"));
+
+  EXPECT_THROW(write_run_json((dir.path() / "no" / "such" / "run.json").string(), scene, info),
+               IoError);
+}
+
+}  // namespace
+}  // namespace dem2d
