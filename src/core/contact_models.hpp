@@ -39,6 +39,7 @@ struct ContactForce {
   double f_n = 0.0;         // N, >= 0 (never attractive)
   double f_t = 0.0;         // N, on i along t
   double k_n = 0.0;         // N/m, normal tangent stiffness (feeds the epsd rolling spring)
+  double k_rate = 0.0;      // 1/s, d(ln k_n)/dt: Hertz stiffness ~ sqrt(delta) -> v_n / (2 delta)
   double dissipated = 0.0;  // J in this step
   double elastic = 0.0;     // J stored (normal + tangential springs)
 };
@@ -51,8 +52,14 @@ inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 // Dissipation: the dashpot's c_t v_t^2 dt while the spring holds; while sliding, the work of
 // the force on the slip minus the change of the spring's energy. (Charging -F_t v_t dt - dU in
 // both cases would count a spurious k_t dxi^2 / 2 each step: an O(dt) drift in the balance.)
-inline void tangential_spring(double k_t, double c_t, double mu_s, double f_n, double v_t,
-                              double dt, double xi_old, ContactHistory& h, ContactForce& out) {
+// A spring whose stiffness follows the overlap (Hertz: k ~ sqrt(delta)) is not derived from a
+// potential: holding xi while delta changes changes 1/2 k xi^2 with no force doing work. That
+// change, 1/2 k xi^2 d(ln k)/dt dt, is booked as dissipated (it may be negative) so that the
+// energy balance closes; `k_rate` is d(ln k)/dt (0 for a constant stiffness).
+inline void tangential_spring(double k_t, double k_rate, double c_t, double mu_s, double f_n,
+                              double v_t, double dt, double xi_old, ContactHistory& h,
+                              ContactForce& out) {
+  out.dissipated -= 0.5 * k_t * xi_old * xi_old * k_rate * dt;
   double xi = xi_old + v_t * dt;
   double f_t = -k_t * xi - c_t * v_t;
   const double cap = mu_s * f_n;
@@ -86,9 +93,10 @@ struct HertzMindlin {
     out.k_n = s_n;
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.4 * f_el * k.delta;  // 8/15 E* sqrt(R*) delta^2.5
+    out.k_rate = 0.5 * k.v_n / k.delta;  // d ln sqrt(delta) / dt, with d(delta)/dt = v_n
     const double s_t = 8.0 * c.g_star * s;
-    tangential_spring(s_t, c.damp * c.tangential_ratio * root, c.mu_s, f_n, k.v_t, dt, old.xi, h,
-                      out);
+    tangential_spring(s_t, out.k_rate, c.damp * c.tangential_ratio * root, c.mu_s, f_n, k.v_t, dt,
+                      old.xi, h, out);
     return out;
   }
 };
@@ -113,6 +121,7 @@ struct ThesisModel {
     out.f_n = f_n;
     out.f_t = f_t;
     out.k_n = s_n;
+    out.k_rate = 0.5 * k.v_n / k.delta;
     out.dissipated = (f_n - f_el) * k.v_n * dt - f_t * k.v_t * dt;
     out.elastic = 0.4 * f_el * k.delta;
     return out;
@@ -135,8 +144,8 @@ struct LinearModel {
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.5 * f_el * k.delta;
     const double k_t = (2.0 / 7.0) * k_n;
-    tangential_spring(k_t, 2.0 * c.gamma_linear * std::sqrt(k_t * k.m_eff), c.mu_s, f_n, k.v_t, dt,
-                      old.xi, h, out);
+    tangential_spring(k_t, 0.0, 2.0 * c.gamma_linear * std::sqrt(k_t * k.m_eff), c.mu_s, f_n,
+                      k.v_t, dt, old.xi, h, out);
     return out;
   }
 };
@@ -151,7 +160,7 @@ struct RollingTorque {
 struct RollingNone {
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
-  static RollingTorque evaluate(const PairCoeffs&, const ContactKinematics&, double, double,
+  static RollingTorque evaluate(const PairCoeffs&, const ContactKinematics&, const ContactForce&,
                                 const ContactHistory&, ContactHistory&, double, double) {
     return {};
   }
@@ -161,9 +170,10 @@ struct RollingNone {
 struct RollingConstant {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
-  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k, double f_n, double,
-                                const ContactHistory&, ContactHistory&, double dt, double) {
-    const double m = -c.mu_r * f_n * k.r_eff * sign(k.omega_rel);
+  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
+                                const ContactForce& cf, const ContactHistory&, ContactHistory&,
+                                double dt, double) {
+    const double m = -c.mu_r * cf.f_n * k.r_eff * sign(k.omega_rel);
     return {m, -m * k.omega_rel * dt, 0.0};
   }
 };
@@ -176,22 +186,26 @@ struct RollingConstant {
 struct RollingEpsd {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
-  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k, double f_n,
-                                double k_n, const ContactHistory& old, ContactHistory& h,
-                                double dt, double eta) {
-    const double k_r = 2.25 * k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
+  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
+                                const ContactForce& cf, const ContactHistory& old,
+                                ContactHistory& h, double dt, double eta) {
+    const double k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
     if (k_r <= 0.0) {
       h.m_roll = 0.0;
       return {};
     }
-    const double m_max = c.mu_r * k.r_eff * f_n;
+    const double m_max = c.mu_r * k.r_eff * cf.f_n;
     double m_k = old.m_roll - k_r * k.omega_rel * dt;
     const double half_compliance = 0.5 / k_r;
+    // Stiffness change at constant torque (see tangential_spring): U = M^2 / (2 k_r) changes by
+    // -U d(ln k_r)/dt dt with no work done; booked as dissipated.
+    const double stiffness_change = half_compliance * old.m_roll * old.m_roll * cf.k_rate * dt;
     if (std::abs(m_k) >= m_max) {  // full mobilisation: plastic rolling, no dashpot
       m_k = std::copysign(m_max, m_k);
       h.m_roll = m_k;
       const double stored_change = half_compliance * (m_k * m_k - old.m_roll * old.m_roll);
-      return {m_k, -m_k * k.omega_rel * dt - stored_change, half_compliance * m_k * m_k};
+      return {m_k, -m_k * k.omega_rel * dt - stored_change + stiffness_change,
+              half_compliance * m_k * m_k};
     }
     const double c_r = eta * 2.0 * std::sqrt(k.i_eff * k_r);
     h.m_roll = m_k;
@@ -199,9 +213,10 @@ struct RollingEpsd {
     if (std::abs(m) > m_max) {  // spring + dashpot never exceed the cap (physics.md section 3)
       const double capped = std::copysign(m_max, m);
       const double stored_change = half_compliance * (m_k * m_k - old.m_roll * old.m_roll);
-      return {capped, -capped * k.omega_rel * dt - stored_change, half_compliance * m_k * m_k};
+      return {capped, -capped * k.omega_rel * dt - stored_change + stiffness_change,
+              half_compliance * m_k * m_k};
     }
-    return {m, c_r * k.omega_rel * k.omega_rel * dt, half_compliance * m_k * m_k};
+    return {m, c_r * k.omega_rel * k.omega_rel * dt + stiffness_change, half_compliance * m_k * m_k};
   }
 };
 

@@ -75,7 +75,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
     dissipated += cf.dissipated;
     elastic += cf.elastic;
     if constexpr (Rolling::kActive) {
-      const RollingTorque rt = Rolling::evaluate(c, kin, cf.f_n, cf.k_n, hist[k], trial[k], dt, eta_r);
+      const RollingTorque rt = Rolling::evaluate(c, kin, cf, hist[k], trial[k], dt, eta_r);
       ti += rt.torque;
       tj -= rt.torque;
       dissipated += rt.dissipated;
@@ -131,7 +131,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
     elastic += cf.elastic;
     if constexpr (Rolling::kActive) {
       const RollingTorque rt =
-          Rolling::evaluate(c, kin, cf.f_n, cf.k_n, wl.history[k], wl.trial[k], dt, eta_r);
+          Rolling::evaluate(c, kin, cf, wl.history[k], wl.trial[k], dt, eta_r);
       m_roll = rt.torque;
       ti += m_roll;
       dissipated += rt.dissipated;

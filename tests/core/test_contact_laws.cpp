@@ -331,7 +331,7 @@ TEST(ThesisLaw, TangentialForceIsCoulombOpposingSlipPlusViscous) {
 TEST(RollingLaw, NoneGivesNoTorque) {
   const PairCoeffs c = steel_pair(1.0, 0.3, 0.1);
   ContactHistory h;
-  const RollingTorque rt = RollingNone::evaluate(c, steel_kinematics(1e-5, 0, 0, 3.0), 100.0, 1e8, {}, h, 1e-6, 0.3);
+  const RollingTorque rt = RollingNone::evaluate(c, steel_kinematics(1e-5, 0, 0, 3.0), ContactForce{100.0, 0.0, 1e8}, {}, h, 1e-6, 0.3);
   EXPECT_EQ(rt.torque, 0.0);
 }
 
@@ -341,11 +341,11 @@ TEST(RollingLaw, ConstantTorqueIsMuRFnRstarOpposingRelativeSpin) {
   ContactHistory h;
   for (const double w : {+2.0, -2.0}) {
     const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
-    const RollingTorque rt = RollingConstant::evaluate(c, k, f_n, 0.0, {}, h, 1e-6, 0.0);
+    const RollingTorque rt = RollingConstant::evaluate(c, k, ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
     EXPECT_NEAR(rt.torque, -0.1 * f_n * k.r_eff * sign(w), 1e-14);
     EXPECT_GT(rt.dissipated, 0.0);
   }
-  const RollingTorque rest = RollingConstant::evaluate(c, steel_kinematics(1e-5), f_n, 0.0, {}, h, 1e-6, 0.0);
+  const RollingTorque rest = RollingConstant::evaluate(c, steel_kinematics(1e-5), ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
   EXPECT_EQ(rest.torque, 0.0);
 }
 
@@ -356,12 +356,12 @@ TEST(RollingLaw, EpsdSpringGrowsByKrOmegaDtOpposingRelativeSpin) {
     const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
     const double k_r = 2.25 * k_n * 0.1 * 0.1 * k.r_eff * k.r_eff;
     ContactHistory old, h;
-    const RollingTorque rt = RollingEpsd::evaluate(c, k, f_n, k_n, old, h, dt, 0.0);  // eta_r = 0
+    const RollingTorque rt = RollingEpsd::evaluate(c, k, ContactForce{f_n, 0.0, k_n}, old, h, dt, 0.0);  // eta_r = 0
     EXPECT_NEAR(h.m_roll, -k_r * w * dt, 1e-12 * k_r * std::abs(w) * dt);
     EXPECT_NEAR(rt.torque, -k_r * w * dt, 1e-12 * k_r * std::abs(w) * dt);
     // A second step adds the same increment.
     ContactHistory h2;
-    RollingEpsd::evaluate(c, k, f_n, k_n, h, h2, dt, 0.0);
+    RollingEpsd::evaluate(c, k, ContactForce{f_n, 0.0, k_n}, h, h2, dt, 0.0);
     EXPECT_NEAR(h2.m_roll, -2.0 * k_r * w * dt, 1e-12 * k_r * std::abs(w) * dt);
   }
 }
@@ -378,7 +378,7 @@ TEST(RollingLaw, EpsdTorqueCapsAtMuRRstarFn) {
   RollingTorque rt;
   for (int s = 0; s < steps_to_cap + 10; ++s) {
     ContactHistory next;
-    rt = RollingEpsd::evaluate(c, k, f_n, k_n, hist, next, dt, 0.3);
+    rt = RollingEpsd::evaluate(c, k, ContactForce{f_n, 0.0, k_n}, hist, next, dt, 0.3);
     if (s + 1 < steps_to_cap) {
       EXPECT_LT(std::abs(next.m_roll), cap) << "step " << s;
     }
@@ -389,7 +389,7 @@ TEST(RollingLaw, EpsdTorqueCapsAtMuRRstarFn) {
   EXPECT_GT(rt.dissipated, 0.0);
   // Reversing the spin unloads the spring below the cap (elastic again).
   ContactHistory back;
-  const RollingTorque r2 = RollingEpsd::evaluate(c, steel_kinematics(1e-5, 0.0, 0.0, -w), f_n, k_n, hist, back, dt, 0.0);
+  const RollingTorque r2 = RollingEpsd::evaluate(c, steel_kinematics(1e-5, 0.0, 0.0, -w), ContactForce{f_n, 0.0, k_n}, hist, back, dt, 0.0);
   EXPECT_NEAR(back.m_roll, -cap + k_r * w * dt, 1e-9 * cap);
   EXPECT_NEAR(r2.torque, back.m_roll, 1e-9 * cap);
 }
@@ -400,7 +400,7 @@ TEST(RollingLaw, EpsdDashpotOpposesRelativeSpinBelowTheCap) {
   const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
   const double k_r = 2.25 * k_n * 0.1 * 0.1 * k.r_eff * k.r_eff;
   ContactHistory h;
-  const RollingTorque rt = RollingEpsd::evaluate(c, k, f_n, k_n, {}, h, 0.0, eta);  // dt = 0: spring unchanged
+  const RollingTorque rt = RollingEpsd::evaluate(c, k, ContactForce{f_n, 0.0, k_n}, {}, h, 0.0, eta);  // dt = 0: spring unchanged
   EXPECT_EQ(h.m_roll, 0.0);
   EXPECT_NEAR(rt.torque, -eta * 2.0 * std::sqrt(k.i_eff * k_r) * w, 1e-12 * std::abs(rt.torque));
   EXPECT_LT(rt.torque, 0.0);
