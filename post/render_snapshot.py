@@ -13,6 +13,7 @@ Particles are drawn at their true radius (in data units), so a packing looks lik
 
 import argparse
 import json
+import math
 import os
 import sys
 
@@ -52,7 +53,7 @@ def read_snapshot(f, name):
 def drum_geometry(args):
     """(radius, (cx, cy)) of the drum, or None."""
     if args.drum_radius is not None:
-        return args.drum_radius, tuple(args.drum_center or (0.0, 0.0))
+        return args.drum_radius, tuple(args.drum_center or (0.0, 0.0)), None
     run_json = args.run_json or os.path.join(os.path.dirname(os.path.abspath(args.snapshots)),
                                              "run.json")
     if not os.path.exists(run_json):
@@ -69,7 +70,45 @@ def drum_geometry(args):
     center = drum.get("center", [0.0, 0.0])
     if args.drum_center:
         center = args.drum_center
-    return float(radius), (float(center[0]), float(center[1]))
+    shell = {"sides": int(drum.get("sides", 0)), "speed": float(drum.get("speed", 0.0)),
+             "ramp_time": float(drum.get("ramp_time", 0.0)),
+             "angle": math.radians(float(drum.get("angle", 0.0))),
+             "lifters": [dict(l) for l in drum.get("lifter", [])]}
+    return float(radius), (float(center[0]), float(center[1])), shell
+
+
+def drum_angle(shell, t):
+    """Drum angle at time t: linear speed ramp from 0 over ramp_time (docs/models.md)."""
+    w, ramp = shell["speed"], shell["ramp_time"]
+    if ramp <= 0.0:
+        turned = w * t
+    elif t < ramp:
+        turned = 0.5 * w * t * t / ramp
+    else:
+        turned = w * (t - 0.5 * ramp)
+    return shell["angle"] + turned
+
+
+def shell_outlines(radius, center, shell, t):
+    """Polylines of the drum's shell (polygon sides) and lifters at time t, in the lab frame."""
+    phi = drum_angle(shell, t)
+    cx, cy = center
+    lines = []
+    n = shell["sides"]
+    if n >= 3:
+        a = phi + 2 * math.pi * np.arange(n + 1) / n
+        lines.append(np.column_stack([cx + radius * np.cos(a), cy + radius * np.sin(a)]))
+    inner = radius if n < 3 else radius * math.cos(math.pi / n)
+    for lifter in shell["lifters"]:
+        h, w = float(lifter["height"]), float(lifter["width"])
+        foot = math.sqrt(max(radius * radius - 0.25 * w * w, 0.0))
+        for k in range(int(lifter["count"])):
+            b = phi + math.radians(float(lifter.get("angle", 0.0))) + 2 * math.pi * k / int(lifter["count"])
+            rad, side = np.array([math.cos(b), math.sin(b)]), np.array([-math.sin(b), math.cos(b)])
+            pts = [foot * rad - 0.5 * w * side, (inner - h) * rad - 0.5 * w * side,
+                   (inner - h) * rad + 0.5 * w * side, foot * rad + 0.5 * w * side]
+            lines.append(np.array(pts) + np.array(center))
+    return lines
 
 
 def render(snap, materials, drum, color, speed_max, out, size, dpi):
@@ -77,8 +116,12 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi):
     fig, ax = plt.subplots(figsize=(size, size), constrained_layout=True)
     ax.set_aspect("equal")
     if drum is not None:
-        radius, center = drum
-        ax.add_patch(Circle(center, radius, fill=False, color="0.3", linewidth=1.5))
+        radius, center, shell = drum
+        if shell is None or shell["sides"] < 3:
+            ax.add_patch(Circle(center, radius, fill=False, color="0.3", linewidth=1.5))
+        if shell is not None:
+            for line in shell_outlines(radius, center, shell, float(snap["time"])):
+                ax.plot(line[:, 0], line[:, 1], color="0.3", linewidth=1.5)
         margin = 0.05 * radius
         ax.set_xlim(center[0] - radius - margin, center[0] + radius + margin)
         ax.set_ylim(center[1] - radius - margin, center[1] + radius + margin)
