@@ -1,0 +1,242 @@
+// Initial placement ([[fill]], [[particle]]) and pair coefficients ([[interaction]]).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/errors.hpp"
+#include "core/fill.hpp"
+#include "core/materials.hpp"
+#include "core/simulation.hpp"
+
+namespace dem2d {
+namespace {
+
+MaterialSpec steel(const std::string& name = "steel") {
+  MaterialSpec m;
+  m.name = name;
+  m.density = 7800;
+  m.youngs_modulus = 2e11;
+  m.poisson_ratio = 0.25;
+  m.shear_modulus = 8e10;
+  m.restitution = 0.5;
+  m.sliding_friction = 0.2;
+  m.rolling_friction = 0.02;
+  return m;
+}
+
+Scene drum_scene(int sides = 0) {
+  Scene s;
+  s.deck_path = "test.in";
+  s.materials.push_back(steel());
+  s.drum.present = true;
+  s.drum.radius = 1.0;
+  s.drum.sides = sides;
+  s.drum.material = "steel";
+  return s;
+}
+
+FillSpec fill(std::int64_t count, double r_min, double r_max, FillRegion region) {
+  FillSpec f;
+  f.material = "steel";
+  f.count = count;
+  f.radius_min = r_min;
+  f.radius_max = r_max;
+  f.region = region;
+  f.source_line = 7;
+  return f;
+}
+
+struct Placed {
+  Walls walls;
+  ParticleStore p;
+};
+
+// Checks no two particles overlap and every particle is inside the shell, off every wall.
+void expect_valid_packing(const Scene& s, const ParticleStore& p, const Walls& walls) {
+  for (std::size_t a = 0; a < p.size(); ++a) {
+    for (std::size_t b = a + 1; b < p.size(); ++b)
+      ASSERT_GE(norm(p.pos[a] - p.pos[b]), p.radius[a] + p.radius[b]) << "ids " << a << ", " << b;
+    for (int e = 0; e < static_cast<int>(walls.elements().size()); ++e)
+      ASSERT_LE(walls.geometry(e, p.pos[a], p.radius[a]).delta, 1e-12) << "id " << a << " wall " << e;
+    if (s.drum.present) ASSERT_LE(norm(p.pos[a] - s.drum.center) + p.radius[a], s.drum.radius + 1e-12);
+  }
+}
+
+TEST(Fill, CountMonodisperseBottomIsLowestAndNonOverlapping) {
+  Scene s = drum_scene();
+  s.fills.push_back(fill(200, 0.03, 0.03, FillRegion::kBottom));
+  Walls walls(s);
+  ParticleStore p;
+  place_particles(s, walls, p);
+  ASSERT_EQ(p.size(), 200u);
+  expect_valid_packing(s, p, walls);
+  double y_max = -1e9;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    EXPECT_EQ(p.id[k], static_cast<std::int64_t>(k));
+    EXPECT_DOUBLE_EQ(p.radius[k], 0.03);
+    EXPECT_DOUBLE_EQ(p.mass[k], 4.0 / 3.0 * std::numbers::pi * 0.03 * 0.03 * 0.03 * 7800);
+    EXPECT_DOUBLE_EQ(1.0 / p.inv_inertia[k], 0.4 * p.mass[k] * 0.03 * 0.03);
+    y_max = std::max(y_max, p.pos[k].y);
+  }
+  // 200 spheres of cross-section 2.83e-3 m^2 cover 0.57 m^2 of the lattice: the lower part of
+  // a 3.14 m^2 drum, well below the centre.
+  EXPECT_LT(y_max, -0.2);
+}
+
+TEST(Fill, FillFractionPolydisperseFullRegion) {
+  Scene s = drum_scene(12);
+  FillSpec f = fill(0, 0.01, 0.03, FillRegion::kFull);
+  f.fill_fraction = 0.2;
+  s.fills.push_back(f);
+  Walls walls(s);
+  ParticleStore p;
+  place_particles(s, walls, p);
+  double area = 0.0, r_lo = 1.0, r_hi = 0.0, y_mean = 0.0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    area += std::numbers::pi * p.radius[k] * p.radius[k];
+    r_lo = std::min(r_lo, p.radius[k]);
+    r_hi = std::max(r_hi, p.radius[k]);
+    y_mean += p.pos[k].y / p.size();
+  }
+  const double target = 0.2 * std::numbers::pi;
+  // The last particle tips the area over the target: within one largest particle.
+  EXPECT_GE(area, target);
+  EXPECT_LT(area - target, std::numbers::pi * 0.03 * 0.03);
+  EXPECT_EQ(static_cast<std::int64_t>(p.size()), fill_count(s, 0));
+  EXPECT_GE(r_lo, 0.01);
+  EXPECT_LE(r_hi, 0.03);
+  EXPECT_GT(r_hi - r_lo, 0.015);           // radii really are spread over the range
+  EXPECT_NEAR(y_mean, 0.0, 0.15);          // "full": spread over the whole drum, not at the bottom
+  expect_valid_packing(s, p, walls);
+}
+
+TEST(Fill, AnnulusTakesTheSitesNearestTheShell) {
+  Scene s = drum_scene();
+  s.fills.push_back(fill(100, 0.02, 0.02, FillRegion::kAnnulus));
+  Walls walls(s);
+  ParticleStore p;
+  place_particles(s, walls, p);
+  ASSERT_EQ(p.size(), 100u);
+  for (std::size_t k = 0; k < p.size(); ++k) EXPECT_GT(norm(p.pos[k]), 0.85);
+  expect_valid_packing(s, p, walls);
+}
+
+TEST(Fill, BoxRegionWithoutDrumAvoidsExplicitParticlesAndWalls) {
+  Scene s;
+  s.deck_path = "test.in";
+  s.materials.push_back(steel());
+  ParticleSpec big;
+  big.material = "steel";
+  big.radius = 0.2;
+  big.position = {0.5, 0.5};
+  s.particles.push_back(big);
+  WallSpec w;
+  w.from = {0.0, 0.3};
+  w.to = {1.0, 0.3};
+  w.material = "steel";
+  s.walls.push_back(w);
+  FillSpec f = fill(60, 0.02, 0.04, FillRegion::kBox);
+  f.box_min = {0.0, 0.0};
+  f.box_max = {1.0, 1.0};
+  s.fills.push_back(f);
+  Walls walls(s);
+  ParticleStore p;
+  place_particles(s, walls, p);
+  ASSERT_EQ(p.size(), 61u);
+  EXPECT_DOUBLE_EQ(p.radius[0], 0.2);  // explicit particles come first, with id 0
+  for (std::size_t k = 1; k < p.size(); ++k) {
+    EXPECT_GE(p.pos[k].x - p.radius[k], -1e-12);
+    EXPECT_LE(p.pos[k].y + p.radius[k], 1.0 + 1e-12);
+  }
+  expect_valid_packing(s, p, walls);
+}
+
+TEST(Fill, SameSeedSamePackingOtherSeedOtherPacking) {
+  Scene s = drum_scene();
+  s.fills.push_back(fill(150, 0.01, 0.03, FillRegion::kFull));
+  Walls walls(s);
+  ParticleStore a, b, c;
+  place_particles(s, walls, a);
+  place_particles(s, walls, b);
+  s.run.seed = 2;
+  place_particles(s, walls, c);
+  int differ = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a.pos[k], b.pos[k]);
+    EXPECT_EQ(a.radius[k], b.radius[k]);
+    differ += !(a.pos[k] == c.pos[k]);
+  }
+  EXPECT_GT(differ, 140);
+}
+
+TEST(Fill, TooManyParticlesIsAnInputErrorNamingTheDeckLine) {
+  Scene s = drum_scene();
+  s.fills.push_back(fill(5000, 0.05, 0.05, FillRegion::kBottom));
+  Walls walls(s);
+  ParticleStore p;
+  try {
+    place_particles(s, walls, p);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("test.in:7: error: [[fill]]: 5000 particles do not fit"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Fill, DrumRegionWithoutDrumIsAnInputError) {
+  Scene s;
+  s.deck_path = "test.in";
+  s.materials.push_back(steel());
+  s.fills.push_back(fill(10, 0.05, 0.05, FillRegion::kBottom));
+  Walls walls(s);
+  ParticleStore p;
+  EXPECT_THROW(place_particles(s, walls, p), InputError);
+}
+
+TEST(Fill, LiftersAreAvoided) {
+  Scene s = drum_scene();
+  LifterSpec l;
+  l.count = 8;
+  l.height = 0.15;
+  l.width = 0.08;
+  s.drum.lifters.push_back(l);
+  s.fills.push_back(fill(300, 0.02, 0.02, FillRegion::kAnnulus));
+  Walls walls(s);
+  ParticleStore p;
+  place_particles(s, walls, p);
+  ASSERT_EQ(walls.elements().size(), 1u + 8u * 3u);
+  expect_valid_packing(s, p, walls);
+}
+
+// [[interaction]]: a listed pair takes its own coefficients; unlisted ones the mean.
+TEST(PairCoefficients, InteractionOverridesTheMeanCoefficientByCoefficient) {
+  Scene s;
+  MaterialSpec a = steel("a"), b = steel("b"), c = steel("c");
+  a.sliding_friction = 0.2;
+  b.sliding_friction = 0.6;
+  c.sliding_friction = 0.4;
+  a.rolling_friction = 0.02;
+  b.rolling_friction = 0.06;
+  s.materials = {a, b, c};
+  InteractionSpec in;
+  in.material_a = "b";
+  in.material_b = "a";
+  in.sliding_friction = 0.9;
+  in.restitution = 0.3;
+  s.interactions.push_back(in);
+  const PairTable t(s);
+  EXPECT_DOUBLE_EQ(t(0, 1).mu_s, 0.9);
+  EXPECT_DOUBLE_EQ(t(1, 0).mu_s, 0.9);
+  EXPECT_DOUBLE_EQ(t(0, 1).restitution, 0.3);
+  EXPECT_DOUBLE_EQ(t(0, 1).mu_r, 0.04);   // not listed: the mean
+  EXPECT_DOUBLE_EQ(t(0, 2).mu_s, 0.3);    // pair not listed: the mean
+  EXPECT_DOUBLE_EQ(t(1, 2).mu_s, 0.5);
+  EXPECT_DOUBLE_EQ(t(2, 2).mu_s, 0.4);
+  // The damping maps the pair's restitution (0.3), not the materials' (0.5).
+  EXPECT_NEAR(restitution_hertz_clamped(-t(0, 1).damp / (2.0 * std::sqrt(5.0 / 6.0))), 0.3, 1e-6);
+}
+
+}  // namespace
+}  // namespace dem2d
