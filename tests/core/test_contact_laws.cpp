@@ -135,7 +135,7 @@ TEST(PairTable, EffectiveModuliFollowPhysicsMdAndCoefficientsAreMeans) {
 TEST(PairTable, RigidWallGivesSphereModulusAlone) {
   Scene s;
   s.materials = {steel(), rigid_like(steel())};
-  const PairCoeffs& c = PairTable(s)(0, 1);
+  const PairCoeffs c = PairTable(s)(0, 1);
   EXPECT_NEAR(c.e_star, 2.0e11 / (1 - 0.25 * 0.25), 1e-12 * c.e_star);
   EXPECT_NEAR(c.g_star, 2.0e11 / (2 * (2 - 0.25) * (1 + 0.25)), 1e-12 * c.g_star);
 }
