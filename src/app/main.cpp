@@ -83,6 +83,8 @@ void print_check(const Simulation& sim) {
   out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
+  out += fmt_double("  smallest restitution:  %.3f", ts.restitution_min) +
+         fmt_double(" -> Hertz contact resolved with %.0f steps (1 %% restitution)\n", ts.steps_per_contact);
   out += fmt_double("  safe dt:               %.4e s (dt = \"auto\")", ts.safe_dt) +
          fmt_double("; refused above %.4e s\n", ts.limit_dt);
   out += fmt_double("  chosen dt:             %.4e s", sim.dt()) +

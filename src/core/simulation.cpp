@@ -184,6 +184,12 @@ std::string format_seconds(double s) {
 
 }  // namespace
 
+double steps_per_contact_for(double restitution) {
+  if (restitution >= 1.0) return 20.0;
+  const double x = -std::log(restitution) / std::log(2.0);
+  return std::max(20.0, 50.0 * std::pow(x, 1.77));
+}
+
 TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   TimeScales ts;
   const double g = norm(scene.run.gravity);
@@ -230,8 +236,27 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
     }
   }
   if (ts.rayleigh == std::numeric_limits<double>::max()) ts.rayleigh = ts.hertz = 1.0;
+  // Smallest restitution among the pairs of materials present (particles and walls). The
+  // thesis law's damping ratio is converted through its hertz-mindlin equivalent (T22).
+  std::vector<char> used(nm, 0);
+  for (std::size_t k = 0; k < p.n_owned(); ++k) used[p.material[k]] = 1;
+  const Walls walls(scene);
+  std::vector<char> touched(nm, 0);
+  for (const WallElement& e : walls.elements()) touched[e.material] = 1;
+  for (std::size_t a = 0; a < nm; ++a) {
+    if (!used[a]) continue;
+    for (std::size_t b = 0; b < nm; ++b) {
+      if (!used[b] && !touched[b]) continue;
+      const PairCoeffs& c = table(static_cast<int>(a), static_cast<int>(b));
+      double e = c.restitution;
+      if (scene.contact.model == ContactModelKind::kThesis)
+        e = restitution_hertz_clamped(-c.zeta_n / std::sqrt(5.0 / 6.0));
+      ts.restitution_min = std::min(ts.restitution_min, e);
+    }
+  }
+  ts.steps_per_contact = steps_per_contact_for(ts.restitution_min);
   const double bound = std::min(ts.rayleigh, ts.hertz);
-  ts.safe_dt = scene.run.dt_safety * bound;
+  ts.safe_dt = std::min(scene.run.dt_safety * ts.rayleigh, ts.hertz / ts.steps_per_contact);
   ts.limit_dt = 0.5 * bound;
   return ts;
 }
@@ -459,6 +484,13 @@ void Simulation::check_stability() {
   o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
   if (!finite) {
     o << "non-finite accelerations";
+    // interface.md (exit 3) asks for the particle ids: name this rank's first few.
+    int named = 0;
+    for (std::size_t k = 0; k < particles_.n_owned() && named < 5; ++k) {
+      const Vec2 a = particles_.acc[k];
+      if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(particles_.alpha[k])) continue;
+      o << (named++ ? ", particle " : " of particle ") << particles_.id[k];
+    }
   } else {
     o << "overlap " << max_overlap << " of a radius between particle " << totals_.worst_a;
     if (totals_.worst_b >= 0)
@@ -467,11 +499,13 @@ void Simulation::check_stability() {
       o << " and a wall";
   }
   o << "; dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt << " s";
+  const std::int64_t failed_step = step_;
+  const double failed_time = time_;
   if (!finite) {
     restore_backup();
     o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
   }
-  throw UnstableError(o.str(), step_, time_);
+  throw UnstableError(o.str(), failed_step, failed_time);
 }
 
 void Simulation::save_backup() {
