@@ -56,7 +56,7 @@ inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 // potential: holding xi while delta changes changes 1/2 k xi^2 with no force doing work. That
 // change, 1/2 k xi^2 d(ln k)/dt dt, is booked as dissipated (it may be negative) so that the
 // energy balance closes; `k_rate` is d(ln k)/dt (0 for a constant stiffness).
-inline void tangential_spring(double k_t, double k_rate, double c_t, double mu_s, double f_n,
+[[gnu::always_inline]] inline void tangential_spring(double k_t, double k_rate, double c_t, double mu_s, double f_n,
                               double v_t, double dt, double xi_old, ContactHistory& h,
                               ContactForce& out) {
   out.dissipated -= 0.5 * k_t * xi_old * xi_old * k_rate * dt;
@@ -81,7 +81,7 @@ inline void tangential_spring(double k_t, double k_rate, double c_t, double mu_s
 //   beta mapped from the restitution asked for the clamped law (materials.hpp).
 struct HertzMindlin {
   static constexpr bool kTorqueArmIsReff = false;
-  static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
+  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
                                const ContactHistory& old, ContactHistory& h, double dt) {
     ContactForce out;
     const double s = std::sqrt(k.r_eff * k.delta);
@@ -107,7 +107,7 @@ struct HertzMindlin {
 // (T23), torques with the arm R* (T15). Normal force clamped at zero like the others.
 struct ThesisModel {
   static constexpr bool kTorqueArmIsReff = true;
-  static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
+  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
                                const ContactHistory&, ContactHistory& h, double dt) {
     ContactForce out;
     const double s = std::sqrt(k.r_eff * k.delta);
@@ -133,7 +133,7 @@ struct ThesisModel {
 // k_t = 2/7 k_n (equal normal and tangential periods for a sphere), c_t = 2 gamma sqrt(k_t m*).
 struct LinearModel {
   static constexpr bool kTorqueArmIsReff = false;
-  static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
+  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
                                const ContactHistory& old, ContactHistory& h, double dt) {
     ContactForce out;
     const double k_n = c.kn_const + c.kn_per_radius * k.r_eff;
@@ -160,7 +160,7 @@ struct RollingTorque {
 struct RollingNone {
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
-  static RollingTorque evaluate(const PairCoeffs&, const ContactKinematics&, const ContactForce&,
+  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs&, const ContactKinematics&, const ContactForce&,
                                 const ContactHistory&, ContactHistory&, double, double) {
     return {};
   }
@@ -170,7 +170,7 @@ struct RollingNone {
 struct RollingConstant {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
-  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
+  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
                                 const ContactForce& cf, const ContactHistory&, ContactHistory&,
                                 double dt, double) {
     const double m = -c.mu_r * cf.f_n * k.r_eff * sign(k.omega_rel);
@@ -186,7 +186,7 @@ struct RollingConstant {
 struct RollingEpsd {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
-  static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
+  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
                                 const ContactForce& cf, const ContactHistory& old,
                                 ContactHistory& h, double dt, double eta) {
     const double k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
