@@ -10,41 +10,86 @@
 //   arm = r_i, r_j (hertz-mindlin, linear) or R* (thesis, T15). Rolling torque M on i, -M on j.
 // Every law also reports the energy it dissipated in the step (J) and the elastic energy it
 // stores, so that kinetic + potential + elastic + dissipated - drive work stays constant.
+//
+// Each law is written once, generic over the value type T: double (one contact) or Pack (a
+// SIMD pack of contacts, core/simd.hpp), and over the coefficient type C (PairCoeffs, or
+// CoeffPack with one coefficient per lane). Branches are selects, so both instantiations
+// perform the same IEEE operations and give the same bits.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 
 #include "core/materials.hpp"
+#include "core/simd.hpp"
 
 namespace dem2d {
 
-struct ContactKinematics {
-  double delta = 0.0;      // overlap, m (> 0)
-  double r_eff = 0.0;      // R*, m
-  double m_eff = 0.0;      // m*, kg
-  double i_eff = 0.0;      // rolling inertia, kg m^2 (epsd only)
-  double v_n = 0.0;        // m/s, > 0 while closing
-  double v_t = 0.0;        // m/s, sliding speed of i's contact point relative to j, along t
-  double omega_rel = 0.0;  // rad/s, w_i - w_j
+template <class T>
+struct KinematicsT {
+  T delta = T(0.0);      // overlap, m (> 0)
+  T r_eff = T(0.0);      // R*, m
+  T m_eff = T(0.0);      // m*, kg
+  T i_eff = T(0.0);      // rolling inertia, kg m^2 (epsd only)
+  T v_n = T(0.0);        // m/s, > 0 while closing
+  T v_t = T(0.0);        // m/s, sliding speed of i's contact point relative to j, along t
+  T omega_rel = T(0.0);  // rad/s, w_i - w_j
 };
+using ContactKinematics = KinematicsT<double>;
 
 // State a contact carries from step to step; created at first touch, deleted when it ends.
-struct ContactHistory {
-  double xi = 0.0;      // tangential spring elongation, m (2D: one scalar)
-  double m_roll = 0.0;  // epsd rolling spring torque, N m
+template <class T>
+struct HistoryT {
+  T xi = T(0.0);      // tangential spring elongation, m (2D: one scalar)
+  T m_roll = T(0.0);  // epsd rolling spring torque, N m
+};
+using ContactHistory = HistoryT<double>;
+
+template <class T>
+struct ContactForceT {
+  T f_n = T(0.0);         // N, >= 0 (never attractive)
+  T f_t = T(0.0);         // N, on i along t
+  T k_n = T(0.0);         // N/m, normal tangent stiffness (feeds the epsd rolling spring)
+  T k_rate = T(0.0);      // 1/s, d(ln k_n)/dt: Hertz stiffness ~ sqrt(delta) -> v_n / (2 delta)
+  T dissipated = T(0.0);  // J in this step
+  T elastic = T(0.0);     // J stored (normal + tangential springs)
+};
+using ContactForce = ContactForceT<double>;
+
+template <class T>
+struct RollingTorqueT {
+  T torque = T(0.0);      // N m on i
+  T dissipated = T(0.0);  // J in this step
+  T elastic = T(0.0);     // J stored in the rolling spring
+};
+using RollingTorque = RollingTorqueT<double>;
+
+// The coefficients of PairCoeffs that the laws read, one per lane of a pack.
+struct CoeffPack {
+  Pack e_star, g_star, mu_s, mu_r, damp, tangential_ratio, zeta_n, zeta_t, kn_const,
+      kn_per_radius, gamma_linear;
+  CoeffPack() = default;
+  explicit CoeffPack(const PairCoeffs& c)
+      : e_star(c.e_star), g_star(c.g_star), mu_s(c.mu_s), mu_r(c.mu_r), damp(c.damp),
+        tangential_ratio(c.tangential_ratio), zeta_n(c.zeta_n), zeta_t(c.zeta_t),
+        kn_const(c.kn_const), kn_per_radius(c.kn_per_radius), gamma_linear(c.gamma_linear) {}
+  // Lane l takes table[index(l)].
+  template <class Index>
+  CoeffPack(const PairCoeffs* table, Index index)
+      : e_star([&](auto l) { return table[index(l)].e_star; }),
+        g_star([&](auto l) { return table[index(l)].g_star; }),
+        mu_s([&](auto l) { return table[index(l)].mu_s; }),
+        mu_r([&](auto l) { return table[index(l)].mu_r; }),
+        damp([&](auto l) { return table[index(l)].damp; }),
+        tangential_ratio([&](auto l) { return table[index(l)].tangential_ratio; }),
+        zeta_n([&](auto l) { return table[index(l)].zeta_n; }),
+        zeta_t([&](auto l) { return table[index(l)].zeta_t; }),
+        kn_const([&](auto l) { return table[index(l)].kn_const; }),
+        kn_per_radius([&](auto l) { return table[index(l)].kn_per_radius; }),
+        gamma_linear([&](auto l) { return table[index(l)].gamma_linear; }) {}
 };
 
-struct ContactForce {
-  double f_n = 0.0;         // N, >= 0 (never attractive)
-  double f_t = 0.0;         // N, on i along t
-  double k_n = 0.0;         // N/m, normal tangent stiffness (feeds the epsd rolling spring)
-  double k_rate = 0.0;      // 1/s, d(ln k_n)/dt: Hertz stiffness ~ sqrt(delta) -> v_n / (2 delta)
-  double dissipated = 0.0;  // J in this step
-  double elastic = 0.0;     // J stored (normal + tangential springs)
-};
-
-inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
+inline double sign(double x) { return vsign(x); }
 
 // Tangential spring-dashpot with a Coulomb cap (hertz-mindlin and linear):
 //   xi += v_t dt, F_t = -k_t xi - c_t v_t, |F_t| <= mu_s F_n; when capped, xi shrinks so the
@@ -56,23 +101,23 @@ inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 // potential: holding xi while delta changes changes 1/2 k xi^2 with no force doing work. That
 // change, 1/2 k xi^2 d(ln k)/dt dt, is booked as dissipated (it may be negative) so that the
 // energy balance closes; `k_rate` is d(ln k)/dt (0 for a constant stiffness).
-[[gnu::always_inline]] inline void tangential_spring(double k_t, double k_rate, double c_t, double mu_s, double f_n,
-                              double v_t, double dt, double xi_old, ContactHistory& h,
-                              ContactForce& out) {
-  out.dissipated -= 0.5 * k_t * xi_old * xi_old * k_rate * dt;
-  double xi = xi_old + v_t * dt;
-  double f_t = -k_t * xi - c_t * v_t;
-  const double cap = mu_s * f_n;
-  if (std::abs(f_t) > cap) {
-    f_t = std::copysign(cap, f_t);
-    xi = k_t > 0.0 ? -f_t / k_t : 0.0;
-    out.dissipated += -f_t * v_t * dt - 0.5 * k_t * (xi * xi - xi_old * xi_old);
-  } else {
-    out.dissipated += c_t * v_t * v_t * dt;
-  }
-  h.xi = xi;
-  out.f_t = f_t;
-  out.elastic += 0.5 * k_t * xi * xi;
+template <class T, class M>
+[[gnu::always_inline]] inline void tangential_spring(T k_t, T k_rate, T c_t, M mu_s, T f_n, T v_t,
+                                                     double dt, T xi_old, HistoryT<T>& h,
+                                                     ContactForceT<T>& out) {
+  out.dissipated = out.dissipated - 0.5 * k_t * xi_old * xi_old * k_rate * dt;
+  const T xi = xi_old + v_t * dt;
+  const T f_t = -k_t * xi - c_t * v_t;
+  const T cap = mu_s * f_n;
+  const auto capped = vabs(f_t) > cap;
+  const T f_t_capped = vcopysign(cap, f_t);
+  const T xi_capped = select(k_t > 0.0, -f_t_capped / k_t, T(0.0));
+  const T slide = -f_t_capped * v_t * dt - 0.5 * k_t * (xi_capped * xi_capped - xi_old * xi_old);
+  const T stick = c_t * v_t * v_t * dt;
+  out.dissipated = out.dissipated + select(capped, slide, stick);
+  h.xi = select(capped, xi_capped, xi);
+  out.f_t = select(capped, f_t_capped, f_t);
+  out.elastic = out.elastic + 0.5 * k_t * h.xi * h.xi;
 }
 
 // Hertz-Mindlin "no-slip" (seed 004, EDEM):
@@ -81,21 +126,23 @@ inline double sign(double x) { return (x > 0.0) - (x < 0.0); }
 //   beta mapped from the restitution asked for the clamped law (materials.hpp).
 struct HertzMindlin {
   static constexpr bool kTorqueArmIsReff = false;
-  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
-                               const ContactHistory& old, ContactHistory& h, double dt) {
-    ContactForce out;
-    const double s = std::sqrt(k.r_eff * k.delta);
-    const double s_n = 2.0 * c.e_star * s;
-    const double f_el = (2.0 / 3.0) * s_n * k.delta;
-    const double root = std::sqrt(s_n * k.m_eff);
-    const double f_n = std::max(0.0, f_el + c.damp * root * k.v_n);
+  template <class T, class C>
+  [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
+                                                          const HistoryT<T>& old, HistoryT<T>& h,
+                                                          double dt) {
+    ContactForceT<T> out;
+    const T s = vsqrt(k.r_eff * k.delta);
+    const T s_n = 2.0 * c.e_star * s;
+    const T f_el = (2.0 / 3.0) * s_n * k.delta;
+    const T root = vsqrt(s_n * k.m_eff);
+    const T f_n = vmax(T(0.0), f_el + c.damp * root * k.v_n);
     out.f_n = f_n;
     out.k_n = s_n;
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.4 * f_el * k.delta;  // 8/15 E* sqrt(R*) delta^2.5
     out.k_rate = 0.5 * k.v_n / k.delta;  // d ln sqrt(delta) / dt, with d(delta)/dt = v_n
-    const double s_t = 8.0 * c.g_star * s;
-    tangential_spring(s_t, out.k_rate, c.damp * c.tangential_ratio * root, c.mu_s, f_n, k.v_t, dt,
+    const T s_t = 8.0 * c.g_star * s;
+    tangential_spring(s_t, out.k_rate, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t, dt,
                       old.xi, h, out);
     return out;
   }
@@ -107,17 +154,19 @@ struct HertzMindlin {
 // (T23), torques with the arm R* (T15). Normal force clamped at zero like the others.
 struct ThesisModel {
   static constexpr bool kTorqueArmIsReff = true;
-  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
-                               const ContactHistory&, ContactHistory& h, double dt) {
-    ContactForce out;
-    const double s = std::sqrt(k.r_eff * k.delta);
-    const double s_n = 2.0 * c.e_star * s;
-    const double f_el = (4.0 / 3.0) * c.e_star * s * k.delta;
-    const double c_n = 2.0 * c.zeta_n * std::sqrt(k.m_eff * s_n);
-    const double f_n = std::max(0.0, f_el + c_n * k.v_n);
-    const double c_t = 4.0 * c.zeta_t * std::sqrt(k.m_eff * 2.0 * c.g_star * s);
-    const double f_t = -c.mu_s * f_n * sign(k.v_t) - c_t * k.v_t;
-    h.xi = 0.0;
+  template <class T, class C>
+  [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
+                                                          const HistoryT<T>&, HistoryT<T>& h,
+                                                          double dt) {
+    ContactForceT<T> out;
+    const T s = vsqrt(k.r_eff * k.delta);
+    const T s_n = 2.0 * c.e_star * s;
+    const T f_el = (4.0 / 3.0) * c.e_star * s * k.delta;
+    const T c_n = 2.0 * c.zeta_n * vsqrt(k.m_eff * s_n);
+    const T f_n = vmax(T(0.0), f_el + c_n * k.v_n);
+    const T c_t = 4.0 * c.zeta_t * vsqrt(k.m_eff * 2.0 * c.g_star * s);
+    const T f_t = -c.mu_s * f_n * vsign(k.v_t) - c_t * k.v_t;
+    h.xi = T(0.0);
     out.f_n = f_n;
     out.f_t = f_t;
     out.k_n = s_n;
@@ -133,35 +182,34 @@ struct ThesisModel {
 // k_t = 2/7 k_n (equal normal and tangential periods for a sphere), c_t = 2 gamma sqrt(k_t m*).
 struct LinearModel {
   static constexpr bool kTorqueArmIsReff = false;
-  [[gnu::always_inline]] static ContactForce evaluate(const PairCoeffs& c, const ContactKinematics& k,
-                               const ContactHistory& old, ContactHistory& h, double dt) {
-    ContactForce out;
-    const double k_n = c.kn_const + c.kn_per_radius * k.r_eff;
-    const double f_el = k_n * k.delta;
-    const double f_n = std::max(0.0, f_el + 2.0 * c.gamma_linear * std::sqrt(k_n * k.m_eff) * k.v_n);
+  template <class T, class C>
+  [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
+                                                          const HistoryT<T>& old, HistoryT<T>& h,
+                                                          double dt) {
+    ContactForceT<T> out;
+    const T k_n = c.kn_const + c.kn_per_radius * k.r_eff;
+    const T f_el = k_n * k.delta;
+    const T f_n = vmax(T(0.0), f_el + 2.0 * c.gamma_linear * vsqrt(k_n * k.m_eff) * k.v_n);
     out.f_n = f_n;
     out.k_n = k_n;
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.5 * f_el * k.delta;
-    const double k_t = (2.0 / 7.0) * k_n;
-    tangential_spring(k_t, 0.0, 2.0 * c.gamma_linear * std::sqrt(k_t * k.m_eff), c.mu_s, f_n,
-                      k.v_t, dt, old.xi, h, out);
+    const T k_t = (2.0 / 7.0) * k_n;
+    tangential_spring(k_t, T(0.0), T(2.0 * c.gamma_linear * vsqrt(k_t * k.m_eff)), c.mu_s, f_n, k.v_t,
+                      dt, old.xi, h, out);
     return out;
   }
-};
-
-struct RollingTorque {
-  double torque = 0.0;      // N m on i
-  double dissipated = 0.0;  // J in this step
-  double elastic = 0.0;     // J stored in the rolling spring
 };
 
 // No rolling resistance: nothing is computed.
 struct RollingNone {
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
-  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs&, const ContactKinematics&, const ContactForce&,
-                                const ContactHistory&, ContactHistory&, double, double) {
+  template <class T, class C>
+  [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C&, const KinematicsT<T>&,
+                                                           const ContactForceT<T>&,
+                                                           const HistoryT<T>&, HistoryT<T>&, double,
+                                                           double) {
     return {};
   }
 };
@@ -170,11 +218,13 @@ struct RollingNone {
 struct RollingConstant {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
-  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
-                                const ContactForce& cf, const ContactHistory&, ContactHistory&,
-                                double dt, double) {
-    const double m = -c.mu_r * cf.f_n * k.r_eff * sign(k.omega_rel);
-    return {m, -m * k.omega_rel * dt, 0.0};
+  template <class T, class C>
+  [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
+                                                           const ContactForceT<T>& cf,
+                                                           const HistoryT<T>&, HistoryT<T>&,
+                                                           double dt, double) {
+    const T m = -c.mu_r * cf.f_n * k.r_eff * vsign(k.omega_rel);
+    return {m, -m * k.omega_rel * dt, T(0.0)};
   }
 };
 
@@ -182,41 +232,44 @@ struct RollingConstant {
 //   k_r = 2.25 k_n mu_r^2 R*^2, M_k += -k_r w_rel dt, |M_k| <= M_max = mu_r R* F_n,
 //   M_d = -eta_r 2 sqrt(I_r k_r) w_rel while |M_k| < M_max (off at full mobilisation), and
 //   |M_k + M_d| <= M_max: the dashpot cannot push the torque past the cap either.
-// eta_r is `rolling_damping` (ContactSpec), passed in as `eta`.
+// eta_r is `rolling_damping` (ContactSpec), passed in as `eta`. Stiffness change at constant
+// torque (see tangential_spring): U = M^2 / (2 k_r) changes by -U d(ln k_r)/dt dt with no work
+// done; booked as dissipated.
 struct RollingEpsd {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
-  [[gnu::always_inline]] static RollingTorque evaluate(const PairCoeffs& c, const ContactKinematics& k,
-                                const ContactForce& cf, const ContactHistory& old,
-                                ContactHistory& h, double dt, double eta) {
-    const double k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
-    if (k_r <= 0.0) {
-      h.m_roll = 0.0;
-      return {};
-    }
-    const double m_max = c.mu_r * k.r_eff * cf.f_n;
-    double m_k = old.m_roll - k_r * k.omega_rel * dt;
-    const double half_compliance = 0.5 / k_r;
-    // Stiffness change at constant torque (see tangential_spring): U = M^2 / (2 k_r) changes by
-    // -U d(ln k_r)/dt dt with no work done; booked as dissipated.
-    const double stiffness_change = half_compliance * old.m_roll * old.m_roll * cf.k_rate * dt;
-    if (std::abs(m_k) >= m_max) {  // full mobilisation: plastic rolling, no dashpot
-      m_k = std::copysign(m_max, m_k);
-      h.m_roll = m_k;
-      const double stored_change = half_compliance * (m_k * m_k - old.m_roll * old.m_roll);
-      return {m_k, -m_k * k.omega_rel * dt - stored_change + stiffness_change,
-              half_compliance * m_k * m_k};
-    }
-    const double c_r = eta * 2.0 * std::sqrt(k.i_eff * k_r);
-    h.m_roll = m_k;
-    const double m = m_k - c_r * k.omega_rel;
-    if (std::abs(m) > m_max) {  // spring + dashpot never exceed the cap (physics.md section 3)
-      const double capped = std::copysign(m_max, m);
-      const double stored_change = half_compliance * (m_k * m_k - old.m_roll * old.m_roll);
-      return {capped, -capped * k.omega_rel * dt - stored_change + stiffness_change,
-              half_compliance * m_k * m_k};
-    }
-    return {m, c_r * k.omega_rel * k.omega_rel * dt + stiffness_change, half_compliance * m_k * m_k};
+  template <class T, class C>
+  [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
+                                                           const ContactForceT<T>& cf,
+                                                           const HistoryT<T>& old, HistoryT<T>& h,
+                                                           double dt, double eta) {
+    const T k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
+    const auto active = k_r > 0.0;  // mu_r = 0: no rolling spring at all
+    const T m_max = c.mu_r * k.r_eff * cf.f_n;
+    const T m_k = old.m_roll - k_r * k.omega_rel * dt;
+    const T half_compliance = 0.5 / k_r;
+    const T stiffness_change = half_compliance * old.m_roll * old.m_roll * cf.k_rate * dt;
+    const T stored_old = old.m_roll * old.m_roll;
+    // Full mobilisation: plastic rolling at the cap, no dashpot.
+    const auto full = vabs(m_k) >= m_max;
+    const T m_full = vcopysign(m_max, m_k);
+    const T diss_full =
+        -m_full * k.omega_rel * dt - half_compliance * (m_full * m_full - stored_old) + stiffness_change;
+    // Elastic: spring plus dashpot, the sum capped too.
+    const T c_r = eta * 2.0 * vsqrt(k.i_eff * k_r);
+    const T m = m_k - c_r * k.omega_rel;
+    const auto over = vabs(m) > m_max;
+    const T m_capped = vcopysign(m_max, m);
+    const T diss_over =
+        -m_capped * k.omega_rel * dt - half_compliance * (m_k * m_k - stored_old) + stiffness_change;
+    const T diss_free = c_r * k.omega_rel * k.omega_rel * dt + stiffness_change;
+    const T spring = select(full, m_full, m_k);
+    h.m_roll = select(active, spring, T(0.0));
+    RollingTorqueT<T> out;
+    out.torque = select(active, select(full, m_full, select(over, m_capped, m)), T(0.0));
+    out.dissipated = select(active, select(full, diss_full, select(over, diss_over, diss_free)), T(0.0));
+    out.elastic = select(active, half_compliance * spring * spring, T(0.0));
+    return out;
   }
 };
 

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "core/contact_batch.hpp"
 #include "core/contact_models.hpp"
 #include "core/errors.hpp"
 #include "core/fill.hpp"
@@ -14,14 +15,16 @@ namespace dem2d {
 
 namespace {
 
-// The pair loop, written once (style.md item 4): particle-particle contacts in canonical
-// (lower id first, sorted) order, then particle-wall contacts. Forces and torques are
-// accumulated into the store; energies and the drive torque into `tot`.
+// The pair loop, written once (style.md item 4) in the three phases of contact_batch.hpp:
+// particle-particle contacts in canonical (lower id first, sorted) order, then particle-wall
+// contacts. Forces and torques are accumulated into the store; energies and the drive torque
+// into `tot`.
 template <class Model, class Rolling>
 void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   ParticleStore& p = sim.particles();
   const PairTable& table = sim.pair_table();
   PairList& pl = sim.pair_list();
+  ContactBatch& b = sim.contact_batch();
   const double eta_r = sim.rolling_damping();
   const Vec2* x = p.pos.data();
   const Vec2* v = p.vel.data();
@@ -35,64 +38,125 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   const std::int32_t* pj = pl.j.data();
   const ContactHistory* hist = pl.history.data();
   ContactHistory* trial = pl.trial.data();
+  const int n_mat = table.n_materials();
 
-  double dissipated = 0.0, elastic = 0.0, max_overlap = 0.0;
-  std::int64_t contacts = 0, worst = -1;
+  // A. Gather the pairs in contact; pairs apart lose their history.
   const std::size_t n_pairs = pl.size();
+  b.reserve(n_pairs + kPackSize);
+  std::size_t n = 0;
   for (std::size_t k = 0; k < n_pairs; ++k) {
     const std::int32_t i = pi[k], j = pj[k];
     const Vec2 d = x[j] - x[i];
     const double dist2 = norm2(d);
     const double rsum = r[i] + r[j];
     if (dist2 >= rsum * rsum) {
-      trial[k] = ContactHistory{};  // no contact: the history ends
+      trial[k] = ContactHistory{};
       continue;
     }
-    const double dist = std::sqrt(dist2);
-    const Vec2 n = (1.0 / dist) * d;
-    const Vec2 t = perp(n);
-    ContactKinematics kin;
+    b.pair[n] = static_cast<std::int32_t>(k);
+    b.coeff[n] = mat[i] * n_mat + mat[j];
+    b.dx[n] = d.x;
+    b.dy[n] = d.y;
+    b.dist2[n] = dist2;
+    b.r_i[n] = r[i];
+    b.r_j[n] = r[j];
+    b.m_i[n] = m[i];
+    b.m_j[n] = m[j];
+    b.vx[n] = v[i].x - v[j].x;
+    b.vy[n] = v[i].y - v[j].y;
+    b.spin[n] = w[i] * r[i] + w[j] * r[j];
+    b.omega_rel[n] = w[i] - w[j];
+    b.xi_old[n] = hist[k].xi;
+    b.mr_old[n] = hist[k].m_roll;
+    ++n;
+  }
+  const std::size_t n_padded = (n + kPackSize - 1) / kPackSize * kPackSize;
+  for (std::size_t c = n; c < n_padded; ++c) b.copy(c, n - 1);
+
+  // B. Kinematics and the contact law, kPackSize contacts at a time.
+  const PairCoeffs* coeffs = table.data();
+  const bool uniform = n_mat == 1;
+  const CoeffPack uniform_coeffs(coeffs[0]);
+  Pack dissipated(0.0), elastic(0.0), max_overlap(0.0);
+  const auto load = [](const std::vector<double>& a, std::size_t c) {
+    return Pack(a.data() + c, stdx::element_aligned);
+  };
+  for (std::size_t c = 0; c < n_padded; c += kPackSize) {
+    const Pack dist = vsqrt(load(b.dist2, c));
+    const Pack inv = 1.0 / dist;
+    const Pack nx = inv * load(b.dx, c), ny = inv * load(b.dy, c);
+    const Pack tx = -ny, ty = nx;
+    const Pack ri = load(b.r_i, c), rj = load(b.r_j, c);
+    const Pack mi = load(b.m_i, c), mj = load(b.m_j, c);
+    const Pack rsum = ri + rj;
+    KinematicsT<Pack> kin;
     kin.delta = rsum - dist;
-    kin.r_eff = r[i] * r[j] / rsum;
-    kin.m_eff = m[i] * m[j] / (m[i] + m[j]);
+    kin.r_eff = ri * rj / rsum;
+    kin.m_eff = mi * mj / (mi + mj);
     if constexpr (Rolling::kNeedsInertia) {
       // I + m r^2 = 7/5 m r^2 about the contact point; harmonic mean of the two bodies.
-      const double a = 1.4 * m[i] * r[i] * r[i], b = 1.4 * m[j] * r[j] * r[j];
-      kin.i_eff = a * b / (a + b);
+      const Pack ia = 1.4 * mi * ri * ri, ib = 1.4 * mj * rj * rj;
+      kin.i_eff = ia * ib / (ia + ib);
     }
-    const Vec2 vrel = (v[i] - v[j]) + (w[i] * r[i] + w[j] * r[j]) * t;
-    kin.v_n = dot(vrel, n);
-    kin.v_t = dot(vrel, t);
-    kin.omega_rel = w[i] - w[j];
-    const PairCoeffs& c = table(mat[i], mat[j]);
-    const ContactForce cf = Model::evaluate(c, kin, hist[k], trial[k], dt);
-    const Vec2 fi = cf.f_t * t - cf.f_n * n;
-    f[i] += fi;
-    f[j] -= fi;
-    const double arm_i = Model::kTorqueArmIsReff ? kin.r_eff : r[i];
-    const double arm_j = Model::kTorqueArmIsReff ? kin.r_eff : r[j];
-    double ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
-    dissipated += cf.dissipated;
-    elastic += cf.elastic;
+    const Pack spin = load(b.spin, c);
+    const Pack vrx = load(b.vx, c) + spin * tx, vry = load(b.vy, c) + spin * ty;
+    kin.v_n = vrx * nx + vry * ny;
+    kin.v_t = vrx * tx + vry * ty;
+    kin.omega_rel = load(b.omega_rel, c);
+    const HistoryT<Pack> old{load(b.xi_old, c), load(b.mr_old, c)};
+    HistoryT<Pack> h;
+    const CoeffPack pc = uniform ? uniform_coeffs
+                                 : CoeffPack(coeffs, [&](auto l) { return b.coeff[c + l]; });
+    const ContactForceT<Pack> cf = Model::evaluate(pc, kin, old, h, dt);
+    const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
+    const Pack arm_i = Model::kTorqueArmIsReff ? kin.r_eff : ri;
+    const Pack arm_j = Model::kTorqueArmIsReff ? kin.r_eff : rj;
+    Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
+    Pack diss = cf.dissipated, el = cf.elastic;
     if constexpr (Rolling::kActive) {
-      const RollingTorque rt = Rolling::evaluate(c, kin, cf, hist[k], trial[k], dt, eta_r);
+      const RollingTorqueT<Pack> rt = Rolling::evaluate(pc, kin, cf, old, h, dt, eta_r);
       ti += rt.torque;
       tj -= rt.torque;
-      dissipated += rt.dissipated;
-      elastic += rt.elastic;
+      diss += rt.dissipated;
+      el += rt.elastic;
     }
-    tq[i] += ti;
-    tq[j] += tj;
-    ++contacts;
-    if (kin.delta > max_overlap * std::min(r[i], r[j])) {
-      max_overlap = kin.delta / std::min(r[i], r[j]);
-      worst = static_cast<std::int64_t>(k);
-    }
+    const Pack ratio = kin.delta / vmin(ri, rj);
+    // Padding lanes repeat the last contact: keep them out of the sums.
+    const PackMask real = Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n);
+    dissipated += select(real, diss, Pack(0.0));
+    elastic += select(real, el, Pack(0.0));
+    max_overlap = vmax(max_overlap, ratio);
+    fx.copy_to(b.fx.data() + c, stdx::element_aligned);
+    fy.copy_to(b.fy.data() + c, stdx::element_aligned);
+    ti.copy_to(b.t_i.data() + c, stdx::element_aligned);
+    tj.copy_to(b.t_j.data() + c, stdx::element_aligned);
+    h.xi.copy_to(b.xi_new.data() + c, stdx::element_aligned);
+    h.m_roll.copy_to(b.mr_new.data() + c, stdx::element_aligned);
+    ratio.copy_to(b.overlap.data() + c, stdx::element_aligned);
   }
-  if (worst >= 0) {
-    tot.worst_a = p.id[pi[worst]];
-    tot.worst_b = p.id[pj[worst]];
+
+  // C. Scatter in canonical pair order.
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t k = b.pair[c];
+    const std::int32_t i = pi[k], j = pj[k];
+    const Vec2 fi{b.fx[c], b.fy[c]};
+    f[i] += fi;
+    f[j] -= fi;
+    tq[i] += b.t_i[c];
+    tq[j] += b.t_j[c];
+    trial[k] = ContactHistory{b.xi_new[c], b.mr_new[c]};
   }
+  double max_ratio = stdx::hmax(max_overlap);
+  std::int64_t contacts = static_cast<std::int64_t>(n);
+  if (max_ratio > kMaxOverlapRatio) {
+    for (std::size_t c = 0; c < n; ++c)
+      if (b.overlap[c] == max_ratio) {
+        tot.worst_a = p.id[pi[b.pair[c]]];
+        tot.worst_b = p.id[pj[b.pair[c]]];
+        break;
+      }
+  }
+  double dissipated_sum = stdx::reduce(dissipated), elastic_sum = stdx::reduce(elastic);
 
   // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel.
   const Walls& walls = sim.walls();
@@ -127,33 +191,33 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
     f[i] += fi;
     double ti = r[i] * cf.f_t;
     double m_roll = 0.0;
-    dissipated += cf.dissipated;
-    elastic += cf.elastic;
+    dissipated_sum += cf.dissipated;
+    elastic_sum += cf.elastic;
     if constexpr (Rolling::kActive) {
       const RollingTorque rt =
           Rolling::evaluate(c, kin, cf, wl.history[k], wl.trial[k], dt, eta_r);
       m_roll = rt.torque;
       ti += m_roll;
-      dissipated += rt.dissipated;
-      elastic += rt.elastic;
+      dissipated_sum += rt.dissipated;
+      elastic_sum += rt.elastic;
     }
     tq[i] += ti;
     // Power the wall's drive puts into the particles: F . v_wall + M Omega (the reaction couple).
     drive_power += dot(fi, vw) + m_roll * body.omega;
     if (e.body == drum) drum_torque += cross(g.point - drum_center, fi) + m_roll;
     ++contacts;
-    if (kin.delta / r[i] > max_overlap) {
-      max_overlap = kin.delta / r[i];
+    if (kin.delta / r[i] > max_ratio) {
+      max_ratio = kin.delta / r[i];
       tot.worst_a = p.id[i];
       tot.worst_b = -1;
     }
   }
   tot.contacts = contacts;
-  tot.dissipated = dissipated;
-  tot.elastic = elastic;
+  tot.dissipated = dissipated_sum;
+  tot.elastic = elastic_sum;
   tot.drum_torque = drum_torque;
   tot.drive_power = drive_power;
-  tot.max_overlap = max_overlap;
+  tot.max_overlap = max_ratio;
 }
 
 template <class Model>

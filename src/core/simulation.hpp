@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/contact_batch.hpp"
 #include "core/diagnostics.hpp"
 #include "core/domain.hpp"
 #include "core/materials.hpp"
@@ -111,6 +112,7 @@ class Simulation {
   Domain& domain() { return *domain_; }
   double rolling_damping() const { return scene_.contact.rolling_damping; }
   PairList& pair_list() { return pairs_; }
+  ContactBatch& contact_batch() { return batch_; }
   WallPairList& wall_pair_list() { return wall_pairs_; }
 
  private:
@@ -134,6 +136,7 @@ class Simulation {
   PairList pairs_;
   WallPairList wall_pairs_;
   ForceKernel kernel_ = nullptr;
+  ContactBatch batch_;
   TimeScales scales_;
 
   double dt_ = 0.0;

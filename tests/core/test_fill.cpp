@@ -59,7 +59,9 @@ void expect_valid_packing(const Scene& s, const ParticleStore& p, const Walls& w
       ASSERT_GE(norm(p.pos[a] - p.pos[b]), p.radius[a] + p.radius[b]) << "ids " << a << ", " << b;
     for (int e = 0; e < static_cast<int>(walls.elements().size()); ++e)
       ASSERT_LE(walls.geometry(e, p.pos[a], p.radius[a]).delta, 1e-12) << "id " << a << " wall " << e;
-    if (s.drum.present) ASSERT_LE(norm(p.pos[a] - s.drum.center) + p.radius[a], s.drum.radius + 1e-12);
+    if (s.drum.present) {
+      ASSERT_LE(norm(p.pos[a] - s.drum.center) + p.radius[a], s.drum.radius + 1e-12);
+    }
   }
 }
 
