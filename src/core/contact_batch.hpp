@@ -15,24 +15,26 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/array.hpp"
+
 namespace dem2d {
 
 struct ContactBatch {
   // Inputs (phase A).
-  std::vector<std::int32_t> pair;   // index into the pair list
-  std::vector<std::int32_t> coeff;  // material pair index into the PairTable
-  std::vector<double> dx, dy;       // x_j - x_i
-  std::vector<double> dist2;        // |x_j - x_i|^2
-  std::vector<double> r_i, r_j, m_i, m_j;
-  std::vector<double> vx, vy;       // v_i - v_j
-  std::vector<double> spin;         // w_i r_i + w_j r_j
-  std::vector<double> omega_rel;    // w_i - w_j
-  std::vector<double> xi_old, mr_old;
+  Array<std::int32_t> pair;   // index into the pair list
+  Array<std::int32_t> coeff;  // material pair index into the PairTable
+  Array<double> dx, dy;       // x_j - x_i
+  Array<double> dist2;        // |x_j - x_i|^2
+  Array<double> r_i, r_j, m_i, m_j;
+  Array<double> vx, vy;       // v_i - v_j
+  Array<double> spin;         // w_i r_i + w_j r_j
+  Array<double> omega_rel;    // w_i - w_j
+  Array<double> xi_old, mr_old;
   // Outputs (phase B).
-  std::vector<double> fx, fy;       // force on i (on j: the opposite)
-  std::vector<double> t_i, t_j;     // torques on i and on j
-  std::vector<double> xi_new, mr_new;
-  std::vector<double> overlap;      // delta / min(r_i, r_j)
+  Array<double> fx, fy;       // force on i (on j: the opposite)
+  Array<double> t_i, t_j;     // torques on i and on j
+  Array<double> xi_new, mr_new;
+  Array<double> overlap;      // delta / min(r_i, r_j)
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
@@ -46,6 +48,42 @@ struct ContactBatch {
   void copy(std::size_t to, std::size_t from) {
     for (auto* v : {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
                     &xi_old, &mr_old})
+      (*v)[to] = (*v)[from];
+    pair[to] = pair[from];
+    coeff[to] = coeff[from];
+  }
+};
+
+// The particle-wall contacts of one force evaluation, in the same three phases: the geometry
+// (closest point, normal, wall velocity) is found in the scalar gather, the law runs on packs,
+// and the scatter adds forces, energies, drive power and drum torque in wall-list order.
+struct WallBatch {
+  // Inputs (phase A).
+  Array<std::int32_t> pair;   // index into the wall pair list
+  Array<std::int32_t> coeff;  // material pair index into the PairTable
+  Array<double> delta, nx, ny;  // overlap; unit normal from the sphere towards the wall
+  Array<double> r, m;
+  Array<double> vx, vy;       // v_rel = (v_i - v_wall) + w_i r_i t
+  Array<double> omega_rel;    // w_i - Omega_wall
+  Array<double> xi_old, mr_old;
+  Array<double> wx, wy;       // wall velocity at the contact point
+  Array<double> px, py;       // contact point
+  // Outputs (phase B).
+  Array<double> fx, fy, torque, m_roll;
+  Array<double> diss_law, el_law, diss_roll, el_roll;
+  Array<double> xi_new, mr_new;
+
+  void reserve(std::size_t n) {
+    if (pair.size() >= n) return;
+    for (auto* v : {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &xi_old, &mr_old, &wx, &wy,
+                    &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll,
+                    &el_roll, &xi_new, &mr_new})
+      v->resize(n);
+    pair.resize(n);
+    coeff.resize(n);
+  }
+  void copy(std::size_t to, std::size_t from) {
+    for (auto* v : {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &xi_old, &mr_old})
       (*v)[to] = (*v)[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];

@@ -11,8 +11,8 @@ namespace {
 
 // Carry histories from `old` (sorted keys) to `fresh` (sorted keys) by key equality.
 template <class KeyOld, class KeyNew>
-void merge_history(std::size_t n_old, KeyOld key_old, const std::vector<ContactHistory>& hist_old,
-                   std::size_t n_new, KeyNew key_new, std::vector<ContactHistory>& hist_new) {
+void merge_history(std::size_t n_old, KeyOld key_old, const Array<ContactHistory>& hist_old,
+                   std::size_t n_new, KeyNew key_new, Array<ContactHistory>& hist_new) {
   hist_new.assign(n_new, ContactHistory{});
   std::size_t a = 0;
   for (std::size_t b = 0; b < n_new && a < n_old; ++b) {

@@ -19,18 +19,18 @@
 namespace dem2d {
 
 struct PairList {
-  std::vector<std::int32_t> i, j;        // local indices
-  std::vector<std::int64_t> id_i, id_j;  // keys, id_i < id_j
-  std::vector<ContactHistory> history;   // committed at the end of each step
-  std::vector<ContactHistory> trial;     // written by each force evaluation
+  Array<std::int32_t> i, j;        // local indices
+  Array<std::int64_t> id_i, id_j;  // keys, id_i < id_j
+  Array<ContactHistory> history;   // committed at the end of each step
+  Array<ContactHistory> trial;     // written by each force evaluation
   std::size_t size() const { return i.size(); }
 };
 
 struct WallPairList {
-  std::vector<std::int32_t> particle, element;
-  std::vector<std::int64_t> id;        // particle id (key with element)
-  std::vector<ContactHistory> history;
-  std::vector<ContactHistory> trial;
+  Array<std::int32_t> particle, element;
+  Array<std::int64_t> id;        // particle id (key with element)
+  Array<ContactHistory> history;
+  Array<ContactHistory> trial;
   std::size_t size() const { return particle.size(); }
 };
 
@@ -51,7 +51,7 @@ class NeighborSearch {
   void build_particle_pairs(const ParticleStore& p, double skin, PairList& out);
   void build_wall_pairs(const ParticleStore& p, const Walls& walls, double skin, WallPairList& out);
 
-  std::vector<std::int32_t> cell_start_, cell_items_, cell_of_, order_, scratch_;
+  Array<std::int32_t> cell_start_, cell_items_, cell_of_, order_, scratch_;
   std::int64_t builds_ = 0;
 };
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/array.hpp"
 #include "core/vec2.hpp"
 
 namespace dem2d {
@@ -51,7 +52,7 @@ class Field final : public FieldBase {
   void pack(std::size_t i, std::byte* out) const override { std::memcpy(out, &data_[i], sizeof(T)); }
   void unpack(std::size_t i, const std::byte* in) override { std::memcpy(&data_[i], in, sizeof(T)); }
   void permute(const std::vector<std::size_t>& order) override {
-    std::vector<T> out(order.size());
+    Array<T> out(order.size());
     for (std::size_t k = 0; k < order.size(); ++k) out[k] = data_[order[k]];
     data_.swap(out);
   }
@@ -61,10 +62,10 @@ class Field final : public FieldBase {
   T* data() { return data_.data(); }
   const T* data() const { return data_.data(); }
   std::size_t size() const { return data_.size(); }
-  const std::vector<T>& vector() const { return data_; }
+  const Array<T>& vector() const { return data_; }
 
  private:
-  std::vector<T> data_;
+  Array<T> data_;
 };
 
 class ParticleStore {

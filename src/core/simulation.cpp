@@ -40,7 +40,9 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   ContactHistory* trial = pl.trial.data();
   const int n_mat = table.n_materials();
 
-  // A. Gather the pairs in contact; pairs apart lose their history.
+  // A. Gather the pairs in contact; pairs apart lose their history. Branch-free compaction:
+  //    every candidate is written to slot n and n advances only for a contact (whether a
+  //    candidate touches is close to random, so a branch here mispredicts often).
   const std::size_t n_pairs = pl.size();
   b.reserve(n_pairs + kPackSize);
   std::size_t n = 0;
@@ -49,26 +51,29 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
     const Vec2 d = x[j] - x[i];
     const double dist2 = norm2(d);
     const double rsum = r[i] + r[j];
-    if (dist2 >= rsum * rsum) {
-      trial[k] = ContactHistory{};
-      continue;
-    }
+    trial[k] = ContactHistory{};  // overwritten by the scatter for the pairs in contact
     b.pair[n] = static_cast<std::int32_t>(k);
-    b.coeff[n] = mat[i] * n_mat + mat[j];
     b.dx[n] = d.x;
     b.dy[n] = d.y;
     b.dist2[n] = dist2;
-    b.r_i[n] = r[i];
-    b.r_j[n] = r[j];
-    b.m_i[n] = m[i];
-    b.m_j[n] = m[j];
-    b.vx[n] = v[i].x - v[j].x;
-    b.vy[n] = v[i].y - v[j].y;
-    b.spin[n] = w[i] * r[i] + w[j] * r[j];
-    b.omega_rel[n] = w[i] - w[j];
-    b.xi_old[n] = hist[k].xi;
-    b.mr_old[n] = hist[k].m_roll;
-    ++n;
+    // Written so that a NaN distance counts as a contact: its NaN forces are then caught by
+    // check_stability instead of the particle silently dropping out of every contact.
+    n += !(dist2 >= rsum * rsum) ? 1 : 0;
+  }
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t k = b.pair[c];
+    const std::int32_t i = pi[k], j = pj[k];
+    b.coeff[c] = mat[i] * n_mat + mat[j];
+    b.r_i[c] = r[i];
+    b.r_j[c] = r[j];
+    b.m_i[c] = m[i];
+    b.m_j[c] = m[j];
+    b.vx[c] = v[i].x - v[j].x;
+    b.vy[c] = v[i].y - v[j].y;
+    b.spin[c] = w[i] * r[i] + w[j] * r[j];
+    b.omega_rel[c] = w[i] - w[j];
+    b.xi_old[c] = hist[k].xi;
+    b.mr_old[c] = hist[k].m_roll;
   }
   const std::size_t n_padded = (n + kPackSize - 1) / kPackSize * kPackSize;
   for (std::size_t c = n; c < n_padded; ++c) b.copy(c, n - 1);
@@ -78,7 +83,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   const bool uniform = n_mat == 1;
   const CoeffPack uniform_coeffs(coeffs[0]);
   Pack dissipated(0.0), elastic(0.0), max_overlap(0.0);
-  const auto load = [](const std::vector<double>& a, std::size_t c) {
+  const auto load = [](const Array<double>& a, std::size_t c) {
     return Pack(a.data() + c, stdx::element_aligned);
   };
   for (std::size_t c = 0; c < n_padded; c += kPackSize) {
@@ -158,60 +163,113 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   }
   double dissipated_sum = stdx::reduce(dissipated), elastic_sum = stdx::reduce(elastic);
 
-  // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel.
+  // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel. The
+  // same three phases as the particle pairs.
   const Walls& walls = sim.walls();
   WallPairList& wl = sim.wall_pair_list();
+  WallBatch& wb = sim.wall_batch();
   const int drum = walls.drum_body();
   const Vec2 drum_center = walls.has_drum() ? walls.bodies()[drum].center : Vec2{};
-  double drum_torque = 0.0, drive_power = 0.0;
+  const WallElement* elements = walls.elements().data();
+  const WallBody* bodies = walls.bodies().data();
+  wb.reserve(wl.size() + kPackSize);
+  std::size_t nw = 0;
   for (std::size_t k = 0; k < wl.size(); ++k) {
     const std::int32_t i = wl.particle[k];
-    const WallElement& e = walls.elements()[wl.element[k]];
+    wl.trial[k] = ContactHistory{};  // overwritten by the scatter for the contacts
+    if (!walls.touches(wl.element[k], x[i], r[i])) continue;
     const WallGeometry g = walls.geometry(wl.element[k], x[i], r[i]);
-    if (g.delta <= 0.0) {
-      wl.trial[k] = ContactHistory{};
-      continue;
-    }
-    const WallBody& body = walls.bodies()[e.body];
+    if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit
+    const WallElement& e = elements[wl.element[k]];
     const Vec2 vw = walls.velocity_at(e.body, g.point);
-    const Vec2 n = g.n;
-    const Vec2 t = perp(n);
-    ContactKinematics kin;
-    kin.delta = g.delta;
-    kin.r_eff = r[i];
-    kin.m_eff = m[i];
-    if constexpr (Rolling::kNeedsInertia) kin.i_eff = 1.4 * m[i] * r[i] * r[i];
+    const Vec2 t = perp(g.n);
     const Vec2 vrel = (v[i] - vw) + (w[i] * r[i]) * t;
-    kin.v_n = dot(vrel, n);
-    kin.v_t = dot(vrel, t);
-    kin.omega_rel = w[i] - body.omega;
-    const PairCoeffs& c = table(mat[i], e.material);
-    const ContactForce cf = Model::evaluate(c, kin, wl.history[k], wl.trial[k], dt);
-    const Vec2 fi = cf.f_t * t - cf.f_n * n;
-    f[i] += fi;
-    double ti = r[i] * cf.f_t;
-    double m_roll = 0.0;
-    dissipated_sum += cf.dissipated;
-    elastic_sum += cf.elastic;
+    wb.pair[nw] = static_cast<std::int32_t>(k);
+    wb.coeff[nw] = mat[i] * n_mat + e.material;
+    wb.delta[nw] = g.delta;
+    wb.nx[nw] = g.n.x;
+    wb.ny[nw] = g.n.y;
+    wb.r[nw] = r[i];
+    wb.m[nw] = m[i];
+    wb.vx[nw] = vrel.x;
+    wb.vy[nw] = vrel.y;
+    wb.omega_rel[nw] = w[i] - bodies[e.body].omega;
+    wb.xi_old[nw] = wl.history[k].xi;
+    wb.mr_old[nw] = wl.history[k].m_roll;
+    wb.wx[nw] = vw.x;
+    wb.wy[nw] = vw.y;
+    wb.px[nw] = g.point.x;
+    wb.py[nw] = g.point.y;
+    ++nw;
+  }
+  const std::size_t nw_padded = (nw + kPackSize - 1) / kPackSize * kPackSize;
+  for (std::size_t c = nw; c < nw_padded; ++c) wb.copy(c, nw - 1);
+  for (std::size_t c = 0; c < nw_padded; c += kPackSize) {
+    const Pack nx = load(wb.nx, c), ny = load(wb.ny, c);
+    const Pack tx = -ny, ty = nx;
+    const Pack ri = load(wb.r, c), mi = load(wb.m, c);
+    KinematicsT<Pack> kin;
+    kin.delta = load(wb.delta, c);
+    kin.r_eff = ri;
+    kin.m_eff = mi;
+    if constexpr (Rolling::kNeedsInertia) kin.i_eff = 1.4 * mi * ri * ri;
+    const Pack vrx = load(wb.vx, c), vry = load(wb.vy, c);
+    kin.v_n = vrx * nx + vry * ny;
+    kin.v_t = vrx * tx + vry * ty;
+    kin.omega_rel = load(wb.omega_rel, c);
+    const HistoryT<Pack> old{load(wb.xi_old, c), load(wb.mr_old, c)};
+    HistoryT<Pack> h;
+    const CoeffPack pc = uniform ? uniform_coeffs
+                                 : CoeffPack(coeffs, [&](auto l) { return wb.coeff[c + l]; });
+    const ContactForceT<Pack> cf = Model::evaluate(pc, kin, old, h, dt);
+    const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
+    Pack ti = ri * cf.f_t, m_roll(0.0), diss_roll(0.0), el_roll(0.0);
     if constexpr (Rolling::kActive) {
-      const RollingTorque rt =
-          Rolling::evaluate(c, kin, cf, wl.history[k], wl.trial[k], dt, eta_r);
+      const RollingTorqueT<Pack> rt = Rolling::evaluate(pc, kin, cf, old, h, dt, eta_r);
       m_roll = rt.torque;
       ti += m_roll;
-      dissipated_sum += rt.dissipated;
-      elastic_sum += rt.elastic;
+      diss_roll = rt.dissipated;
+      el_roll = rt.elastic;
     }
-    tq[i] += ti;
+    fx.copy_to(wb.fx.data() + c, stdx::element_aligned);
+    fy.copy_to(wb.fy.data() + c, stdx::element_aligned);
+    ti.copy_to(wb.torque.data() + c, stdx::element_aligned);
+    m_roll.copy_to(wb.m_roll.data() + c, stdx::element_aligned);
+    cf.dissipated.copy_to(wb.diss_law.data() + c, stdx::element_aligned);
+    cf.elastic.copy_to(wb.el_law.data() + c, stdx::element_aligned);
+    diss_roll.copy_to(wb.diss_roll.data() + c, stdx::element_aligned);
+    el_roll.copy_to(wb.el_roll.data() + c, stdx::element_aligned);
+    h.xi.copy_to(wb.xi_new.data() + c, stdx::element_aligned);
+    h.m_roll.copy_to(wb.mr_new.data() + c, stdx::element_aligned);
+  }
+  double drum_torque = 0.0, drive_power = 0.0;
+  for (std::size_t c = 0; c < nw; ++c) {
+    const std::int32_t k = wb.pair[c];
+    const std::int32_t i = wl.particle[k];
+    const WallElement& e = elements[wl.element[k]];
+    const Vec2 fi{wb.fx[c], wb.fy[c]};
+    const Vec2 vw{wb.wx[c], wb.wy[c]};
+    const double m_roll = wb.m_roll[c];
+    f[i] += fi;
+    tq[i] += wb.torque[c];
+    dissipated_sum += wb.diss_law[c];
+    elastic_sum += wb.el_law[c];
+    if constexpr (Rolling::kActive) {
+      dissipated_sum += wb.diss_roll[c];
+      elastic_sum += wb.el_roll[c];
+    }
+    wl.trial[k] = ContactHistory{wb.xi_new[c], wb.mr_new[c]};
     // Power the wall's drive puts into the particles: F . v_wall + M Omega (the reaction couple).
-    drive_power += dot(fi, vw) + m_roll * body.omega;
-    if (e.body == drum) drum_torque += cross(g.point - drum_center, fi) + m_roll;
-    ++contacts;
-    if (kin.delta / r[i] > max_ratio) {
-      max_ratio = kin.delta / r[i];
+    drive_power += dot(fi, vw) + m_roll * bodies[e.body].omega;
+    if (e.body == drum) drum_torque += cross(Vec2{wb.px[c], wb.py[c]} - drum_center, fi) + m_roll;
+    const double ratio = wb.delta[c] / wb.r[c];
+    if (ratio > max_ratio) {
+      max_ratio = ratio;
       tot.worst_a = p.id[i];
       tot.worst_b = -1;
     }
   }
+  contacts += static_cast<std::int64_t>(nw);
   tot.contacts = contacts;
   tot.dissipated = dissipated_sum;
   tot.elastic = elastic_sum;
@@ -376,28 +434,44 @@ void Simulation::refresh_forces() {
   wall_pairs_.history = wall_pairs_.trial;
 }
 
-void Simulation::evaluate_forces(double dt_history) {
+void Simulation::evaluate_forces(double dt_history, double kick, bool owned_cleared) {
   ParticleStore& p = particles_;
   const std::size_t n = p.size();
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
-  for (std::size_t k = 0; k < n; ++k) {
+  for (std::size_t k = owned_cleared ? p.n_owned() : 0; k < n; ++k) {
     f[k] = {};
     tq[k] = 0.0;
   }
   totals_ = EvaluationTotals{};
   kernel_(*this, dt_history, totals_);
-  // Accelerations; gravity added last, the same way for every particle.
+  // Accelerations; gravity added last, the same way for every particle. The checksum (a plain
+  // sum: any NaN or infinity makes it non-finite) is tested by check_stability.
   const std::size_t n_owned = p.n_owned();
   Vec2* a = p.acc.data();
   double* al = p.alpha.data();
   const double* inv_m = p.inv_mass.data();
   const double* inv_i = p.inv_inertia.data();
   double checksum = 0.0;
-  for (std::size_t k = 0; k < n_owned; ++k) {
-    a[k] = inv_m[k] * f[k] + gravity_;
-    al[k] = inv_i[k] * tq[k];
-    checksum += std::abs(a[k].x) + std::abs(a[k].y) + std::abs(al[k]);
+  if (kick == 0.0) {
+#pragma omp simd reduction(+ : checksum)
+    for (std::size_t k = 0; k < n_owned; ++k) {
+      a[k] = inv_m[k] * f[k] + gravity_;
+      al[k] = inv_i[k] * tq[k];
+      checksum += (a[k].x + a[k].y) + al[k];
+    }
+  } else {
+    // Velocity Verlet's closing half kick, fused with the accelerations.
+    Vec2* v = p.vel.data();
+    double* w = p.omega.data();
+#pragma omp simd reduction(+ : checksum)
+    for (std::size_t k = 0; k < n_owned; ++k) {
+      a[k] = inv_m[k] * f[k] + gravity_;
+      al[k] = inv_i[k] * tq[k];
+      checksum += (a[k].x + a[k].y) + al[k];
+      v[k] += kick * a[k];
+      w[k] += kick * al[k];
+    }
   }
   accel_checksum_ = checksum;
 }
@@ -438,23 +512,27 @@ void Simulation::step_verlet() {
   double* w = p.omega.data();
   const double* al = p.alpha.data();
   const Vec2* xb = pos_at_build_.data();
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  // Half kick, drift, clear the force accumulators and track the largest displacement since
+  // the last neighbour build, in one pass.
   double disp2 = max_disp2_;
+#pragma omp simd reduction(max : disp2)
   for (std::size_t k = 0; k < n; ++k) {
     v[k] += h * a[k];
     w[k] += h * al[k];
     x[k] += dt_ * v[k];
     th[k] += dt_ * w[k];
-    disp2 = std::max(disp2, norm2(x[k] - xb[k]));
+    f[k] = {};
+    tq[k] = 0.0;
+    const double d2 = norm2(x[k] - xb[k]);
+    disp2 = disp2 > d2 ? disp2 : d2;
   }
   max_disp2_ = disp2;
   time_ = static_cast<double>(step_ + 1) * dt_;
   walls_.update(time_);
   if (rebuild_needed()) rebuild();
-  evaluate_forces(dt_);
-  for (std::size_t k = 0; k < n; ++k) {
-    v[k] += h * a[k];
-    w[k] += h * al[k];
-  }
+  evaluate_forces(dt_, h, true);
   commit_history();
   account(totals_, dt_);
   last_passes_ = 1;
@@ -476,8 +554,8 @@ void Simulation::step_iterative() {
   th0_.assign(p.theta.data(), p.theta.data() + n);
   w0_.assign(p.omega.data(), p.omega.data() + n);
   al0_.assign(p.alpha.data(), p.alpha.data() + n);
-  std::vector<Vec2> a1(a0_);
-  std::vector<double> al1(al0_);
+  Array<Vec2> a1(a0_);
+  Array<double> al1(al0_);
   const double dt = dt_, c2 = dt * dt / 6.0;
   const double eps = scene_.run.tolerance;
   const double a_ref = std::max(norm(gravity_), 1e-12);

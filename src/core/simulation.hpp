@@ -113,10 +113,14 @@ class Simulation {
   double rolling_damping() const { return scene_.contact.rolling_damping; }
   PairList& pair_list() { return pairs_; }
   ContactBatch& contact_batch() { return batch_; }
+  WallBatch& wall_batch() { return wall_batch_; }
   WallPairList& wall_pair_list() { return wall_pairs_; }
 
  private:
-  void evaluate_forces(double dt_history);
+  // Forces, torques and accelerations at the current state; contact histories advanced by
+  // dt_history into the trial slots. kick != 0 also applies v += kick a (Verlet's closing half
+  // kick); owned_cleared: the owned particles' accumulators are already zero.
+  void evaluate_forces(double dt_history, double kick = 0.0, bool owned_cleared = false);
   void step_verlet();
   void step_iterative();
   bool rebuild_needed() const;
@@ -137,6 +141,7 @@ class Simulation {
   WallPairList wall_pairs_;
   ForceKernel kernel_ = nullptr;
   ContactBatch batch_;
+  WallBatch wall_batch_;
   TimeScales scales_;
 
   double dt_ = 0.0;
@@ -146,14 +151,14 @@ class Simulation {
   Vec2 gravity_{};
 
   // Rebuild bookkeeping: positions and wall pose at the last build.
-  std::vector<Vec2> pos_at_build_;
+  Array<Vec2> pos_at_build_;
   double drum_angle_at_build_ = 0.0;
   double time_at_build_ = 0.0;
   double max_disp2_ = 0.0;
 
   // Iterative integrator: state at the start of the step.
-  std::vector<Vec2> x0_, v0_, a0_;
-  std::vector<double> th0_, w0_, al0_;
+  Array<Vec2> x0_, v0_, a0_;
+  Array<double> th0_, w0_, al0_;
   int last_passes_ = 0;
   std::int64_t passes_total_ = 0;
   std::int64_t passes_since_row_ = 0;
