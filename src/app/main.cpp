@@ -25,6 +25,7 @@
 #include "io/run_json.hpp"
 #include "io/series.hpp"
 #include "io/snapshots.hpp"
+#include "parallel/mpi_domain.hpp"
 
 namespace {
 
@@ -104,21 +105,21 @@ class Progress {
   Progress(bool quiet, double duration, double interval)
       : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), duration_(duration), interval_(interval),
         start_(Clock::now()), last_(start_) {}
-  void update(const Simulation& sim, bool final_line = false) {
+  void update(const Simulation& sim, std::int64_t n_particles, bool final_line = false) {
     if (quiet_ || g_rank != 0) return;
     const auto now = Clock::now();
     const double since = std::chrono::duration<double>(now - last_).count();
     if (!final_line && since < (tty_ ? 0.5 : interval_)) return;
     last_ = now;
     const double wall = std::chrono::duration<double>(now - start_).count();
-    const double rate = wall > 0 ? static_cast<double>(sim.particles().n_owned()) * sim.step_count() / wall : 0;
+    const double rate = wall > 0 ? static_cast<double>(n_particles) * sim.step_count() / wall : 0;
     const double frac = sim.time() / duration_;
     const double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
     char line[256];
     std::snprintf(line, sizeof line,
-                  "step %lld  t = %.4f / %.4g s  particles %zu  %.3g particle-steps/s  ETA %.0f s",
+                  "step %lld  t = %.4f / %.4g s  particles %lld  %.3g particle-steps/s  ETA %.0f s",
                   static_cast<long long>(sim.step_count()), sim.time(), duration_,
-                  sim.particles().n_owned(), rate, eta);
+                  static_cast<long long>(n_particles), rate, eta);
     if (tty_)
       std::fprintf(stderr, "\r%s\033[K%s", line, final_line ? "\n" : "");
     else
@@ -132,23 +133,25 @@ class Progress {
   Clock::time_point start_, last_;
 };
 
-// Rank 0 owns every particle for output until the decomposition lands (issue 3): the other
-// ranks run the same deterministic simulation and write nothing.
-const ParticleStore& output_view(const Simulation& sim) {
-  static const ParticleStore empty;
-  return g_rank == 0 ? sim.particles() : empty;
-}
-
 int run(const Options& opt) {
   Scene scene = load_deck(opt.deck, opt.sets);
   if (!opt.output.empty()) scene.output.directory = opt.output;
   if (!opt.restart.empty())
     throw InputError("--restart " + opt.restart + ": error: restarting from a checkpoint is not implemented yet");
-  Simulation sim(scene);
+  // The angular-sector decomposition about the drum centre (the particles' centre without a
+  // drum); on one rank its verbs are trivial.
+  DecompositionOptions decomposition;
+  decomposition.has_center = scene.drum.present;
+  decomposition.center = scene.drum.center;
   if (opt.check) {
-    print_check(sim);
+    // Every rank evaluates the whole scene alike; rank 0 prints.
+    const Simulation whole(scene);
+    print_check(whole);
     return kExitOk;
   }
+  MpiDomain domain(MPI_COMM_WORLD, decomposition);
+  Simulation sim(scene, &domain);
+  const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
   const OutputSpec& out = scene.output;
   try {
     prepare_output_directory(MPI_COMM_WORLD, out.directory);
@@ -184,7 +187,7 @@ int run(const Options& opt) {
   };
   SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
   if (!opt.quiet)
-    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(sim.particles().n_owned()) +
+    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(n_global) +
         " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
         (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory + "\n");
 
@@ -200,7 +203,7 @@ int run(const Options& opt) {
   write_row(sim.diagnostics());
   sim.reset_pass_window();
   if (out.snapshot_interval > 0) {
-    snapshots.write(output_view(sim), sim.time(), sim.step_count());
+    snapshots.write(sim.particles(), sim.time(), sim.step_count());
     last_snapshot_time = sim.time();
   }
   try {
@@ -211,21 +214,21 @@ int run(const Options& opt) {
         sim.reset_pass_window();
       }
       if (at_multiple(sim.time(), out.snapshot_interval)) {
-        snapshots.write(output_view(sim), sim.time(), sim.step_count());
+        snapshots.write(sim.particles(), sim.time(), sim.step_count());
         last_snapshot_time = sim.time();
       }
-      progress.update(sim);
+      progress.update(sim, n_global);
     }
   } catch (const UnstableError& e) {
-    snapshots.write(output_view(sim), sim.time(), sim.step_count());
+    snapshots.write(sim.particles(), sim.time(), sim.step_count());
     say(scene.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
             "/snapshots.h5\n",
         stderr);
     return kExitUnstable;
   }
-  if (last_snapshot_time != sim.time()) snapshots.write(output_view(sim), sim.time(), sim.step_count());
+  if (last_snapshot_time != sim.time()) snapshots.write(sim.particles(), sim.time(), sim.step_count());
   if (!at_multiple(sim.time(), out.series_interval)) write_row(sim.diagnostics());
-  progress.update(sim, true);
+  progress.update(sim, n_global, true);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   RunInfo info;
   info.version = DEM2D_VERSION;
@@ -233,13 +236,39 @@ int run(const Options& opt) {
   info.wall_time_s = wall;
   info.steps = sim.step_count();
   info.particle_steps_per_second =
-      wall > 0 ? static_cast<double>(sim.particles().n_owned()) * sim.step_count() / wall : 0.0;
+      wall > 0 ? static_cast<double>(n_global) * sim.step_count() / wall : 0.0;
   info.dt = sim.dt();
   info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
   if (scene.run.integrator == IntegratorKind::kIterative) {
     info.extra.emplace_back("mean_passes", fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
                                                                   std::max<std::int64_t>(1, sim.step_count())));
     info.extra.emplace_back("unconverged_steps", std::to_string(sim.unconverged_steps()));
+  }
+  {
+    // The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
+    // ghosts, migrations and time in communication; the imbalance against equal angles.
+    const DecompositionStats& ds = domain.stats();
+    const std::vector<double> work = domain.gather_work();
+    const auto gather = [&](double x) {
+      std::vector<double> all(static_cast<std::size_t>(g_size));
+      MPI_Allgather(&x, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD);
+      return all;
+    };
+    const std::vector<double> ghosts = gather(static_cast<double>(ds.ghosts));
+    const std::vector<double> comm = gather(ds.comm_seconds);
+    const auto list = [](const std::vector<double>& v, const char* fmt) {
+      std::string out = "[";
+      for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + fmt_double(fmt, v[k]);
+      return out + "]";
+    };
+    info.extra.emplace_back("rank_work", list(work, "%.0f"));
+    info.extra.emplace_back("rank_ghosts", list(ghosts, "%.0f"));
+    info.extra.emplace_back("rank_comm_seconds", list(comm, "%.4g"));
+    info.extra.emplace_back("imbalance", fmt_double("%.4g", ds.imbalance_work));
+    info.extra.emplace_back("imbalance_equal_angle", fmt_double("%.4g", ds.imbalance_equal_angle));
+    info.extra.emplace_back("partitions", std::to_string(ds.partitions));
+    info.extra.emplace_back("partition_method", "\"" + ds.method + "\"");
+    info.extra.emplace_back("sectors", std::to_string(domain.partition().n_sectors));
   }
   if (g_rank == 0) write_run_json(out.directory + "/run.json", scene, info);
   if (!opt.quiet)

@@ -3,13 +3,37 @@
 // The core calls these verbs at fixed points of a step; the serial implementation below is
 // trivial and is what the core's tests use. src/parallel/ implements them with MPI (angular
 // sectors, halo exchange, migration) without the physics ever seeing MPI.
+//
+// When the core calls them (core/simulation.cpp):
+//   construction: every rank holds the same full set of particles -> adopt() keeps this
+//     rank's own, then the first rebuild;
+//   a neighbour rebuild (decided with any(), so on every rank at the same step):
+//     migrate() (particles that left this rank's region go to their new owner with every
+//     registered field and the contact histories that involve them) -> exchange_halo() (a new
+//     ghost set) -> the core builds the neighbour lists over owned + ghosts;
+//   every other force evaluation: refresh_ghosts() (positions, velocities, spins of the same
+//     ghosts, in the same slots).
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
+#include "core/contact_models.hpp"
 #include "core/particles.hpp"
 
 namespace dem2d {
+
+// A contact history keyed by particle ids, so that it can travel with its particle.
+// b >= 0: the pair (a, b) with a < b; b < 0: particle a against wall element -1 - b.
+struct HistoryRecord {
+  std::int64_t a = 0;
+  std::int64_t b = 0;
+  ContactHistory h{};
+  friend bool operator<(const HistoryRecord& x, const HistoryRecord& y) {
+    return x.a < y.a || (x.a == y.a && x.b < y.b);
+  }
+};
 
 class Domain {
  public:
@@ -22,12 +46,25 @@ class Domain {
   virtual double max(double x) const { return x; }
   virtual std::int64_t sum(std::int64_t x) const { return x; }
   virtual bool any(bool x) const { return x; }
-  // Move owned particles that left this rank's region to their new owner (with all fields).
-  virtual void migrate(ParticleStore&) {}
-  // Rebuild ghost copies of other ranks' particles near this rank's region.
-  virtual void exchange_halo(ParticleStore&, double /*halo_width*/) {}
-  // Refresh ghost positions and velocities from their owners (same ghost set).
-  virtual void refresh_ghosts(ParticleStore&) {}
+
+  // Every rank holds the same full set of owned particles (the fill is deterministic): keep
+  // those in this rank's region, drop the rest. halo_width: how far from its region a rank
+  // needs ghost copies (largest contact reach plus the Verlet skin).
+  virtual void adopt(ParticleStore&, double /*halo_width*/) {}
+  // Move owned particles that left this rank's region to their new owner with all their
+  // registered fields. `histories` holds this rank's contact histories on entry; records
+  // that involve a leaving particle travel with it. On return it holds, sorted and without
+  // duplicates, every history this rank needs for the particles it now owns. Throws
+  // std::runtime_error (on every rank alike) when a particle jumped farther than the halo.
+  virtual void migrate(ParticleStore&, std::vector<HistoryRecord>& /*histories*/) {}
+  // Rebuild the ghost copies of other ranks' particles within the halo width of this rank's
+  // region (all registered fields). Ghosts follow the owned particles in the store.
+  virtual void exchange_halo(ParticleStore&) {}
+  // Refresh the given fields of the same ghosts from their owners.
+  virtual void refresh_ghosts(ParticleStore&, std::span<FieldBase* const> /*fields*/) {}
+  // Called after each neighbour rebuild with this rank's work (owned particles + listed pairs);
+  // a parallel domain may repartition at its next migrate() when the imbalance grew.
+  virtual void report_work(double /*work*/) {}
 };
 
 }  // namespace dem2d

@@ -43,6 +43,14 @@ std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, dou
   return i;
 }
 
+std::size_t ParticleStore::add_owned(std::size_t n) {
+  if (n_ghost() != 0) throw std::logic_error("ParticleStore::add_owned with ghosts present");
+  const std::size_t first = size();
+  resize_all(first + n);
+  n_owned_ = first + n;
+  return first;
+}
+
 void ParticleStore::remove_if(const std::vector<char>& remove) {
   clear_ghosts();
   std::size_t k = 0;

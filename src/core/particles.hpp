@@ -105,6 +105,9 @@ class ParticleStore {
   // Append an owned particle (no ghosts may be present). Returns its index.
   std::size_t add(std::int64_t pid, std::int32_t mat, double r, double density, Vec2 x, Vec2 v,
                   double spin);
+  // Append n owned particle slots (no ghosts may be present); returns the first index. The
+  // caller fills every field (migration unpacks them).
+  std::size_t add_owned(std::size_t n);
   // Remove the owned particles whose flag is set, keeping the order of the rest.
   void remove_if(const std::vector<char>& remove);
   // Reorder owned particles: new[k] = old[order[k]].

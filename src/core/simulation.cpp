@@ -403,29 +403,92 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
       throw InputError(o.str());
     }
   }
-  double r_min = std::numeric_limits<double>::max();
-  for (std::size_t k = 0; k < particles_.size(); ++k) r_min = std::min(r_min, particles_.radius[k]);
+  double r_min = std::numeric_limits<double>::max(), r_max = 0.0;
+  for (std::size_t k = 0; k < particles_.size(); ++k) {
+    r_min = std::min(r_min, particles_.radius[k]);
+    r_max = std::max(r_max, particles_.radius[k]);
+  }
   skin_ = scene_.run.skin >= 0.0 ? scene_.run.skin : (particles_.size() ? 0.4 * r_min : 0.0);
+  // Every rank placed the same particles; from here on each keeps its own (parallel runs).
+  // A pair interacts within r_i + r_j + skin, so a rank needs the particles within
+  // 2 r_max + skin of its region.
+  halo_width_ = 2.0 * r_max + skin_;
+  ghost_fields_ = {&particles_.pos, &particles_.vel, &particles_.omega};
+  domain_->adopt(particles_, halo_width_);
   rebuild();
   refresh_forces();
   save_backup();
 }
 
 void Simulation::rebuild() {
+  const bool parallel = domain_->size() > 1;
+  if (parallel) {
+    // Particles that left this rank's region move to their owner with their contact
+    // histories; then a new ghost set; the lists below take their histories from the records.
+    std::vector<HistoryRecord> records = history_records();
+    domain_->migrate(particles_, records);
+    domain_->exchange_halo(particles_);
+    adopt_history_records(records);
+  }
   search_.build(particles_, walls_, skin_, pairs_, wall_pairs_);
+  if (parallel) domain_->report_work(static_cast<double>(particles_.n_owned() + pairs_.size()));
   pos_at_build_.assign(particles_.pos.data(), particles_.pos.data() + particles_.n_owned());
   drum_angle_at_build_ = walls_.drum_angle();
   time_at_build_ = time_;
   max_disp2_ = 0.0;
 }
 
-bool Simulation::rebuild_needed() const {
+bool Simulation::rebuild_needed(double disp) const {
   // Two particles approach by at most twice the largest displacement; a wall moves at most
-  // rotating_reach * |drum angle change| + translation speed * elapsed time.
+  // rotating_reach * |drum angle change| + translation speed * elapsed time. Decided on every
+  // rank together.
   const double wall_move = walls_.rotating_reach() * std::abs(walls_.drum_angle() - drum_angle_at_build_) +
                            walls_.max_translation_speed() * (time_ - time_at_build_);
-  const double disp = std::sqrt(max_disp2_);
   return domain_->any(2.0 * disp + wall_move >= skin_);
+}
+
+std::vector<HistoryRecord> Simulation::history_records() const {
+  std::vector<HistoryRecord> out;
+  const auto live = [](const ContactHistory& h) { return h.xi != 0.0 || h.m_roll != 0.0; };
+  for (std::size_t k = 0; k < pairs_.size(); ++k)
+    if (live(pairs_.history[k])) out.push_back({pairs_.id_i[k], pairs_.id_j[k], pairs_.history[k]});
+  for (std::size_t k = 0; k < wall_pairs_.size(); ++k)
+    if (live(wall_pairs_.history[k]))
+      out.push_back({wall_pairs_.id[k], -1 - static_cast<std::int64_t>(wall_pairs_.element[k]),
+                     wall_pairs_.history[k]});
+  return out;
+}
+
+void Simulation::adopt_history_records(const std::vector<HistoryRecord>& records) {
+  // The lists become key + history only: NeighborSearch::build carries histories from the
+  // old lists by key (pairs sorted by (id_i, id_j), walls by (id, element)).
+  PairList pl;
+  WallPairList wl;
+  for (const HistoryRecord& r : records) {
+    if (r.b >= 0) {
+      pl.id_i.push_back(r.a);
+      pl.id_j.push_back(r.b);
+      pl.history.push_back(r.h);
+    } else {
+      wl.id.push_back(r.a);
+      wl.element.push_back(static_cast<std::int32_t>(-1 - r.b));
+      wl.history.push_back(r.h);
+    }
+  }
+  // Records are sorted by (a, b); wall keys need (id, element) order: b = -1 - element runs
+  // backwards within one id.
+  for (std::size_t s = 0; s < wl.id.size();) {
+    std::size_t e = s;
+    while (e < wl.id.size() && wl.id[e] == wl.id[s]) ++e;
+    std::reverse(wl.element.begin() + static_cast<std::ptrdiff_t>(s), wl.element.begin() + static_cast<std::ptrdiff_t>(e));
+    std::reverse(wl.history.begin() + static_cast<std::ptrdiff_t>(s), wl.history.begin() + static_cast<std::ptrdiff_t>(e));
+    s = e;
+  }
+  pl.i.resize(pl.id_i.size());
+  pl.j.resize(pl.id_i.size());
+  wl.particle.resize(wl.id.size());
+  pairs_ = std::move(pl);
+  wall_pairs_ = std::move(wl);
 }
 
 void Simulation::refresh_forces() {
@@ -493,7 +556,9 @@ void Simulation::step() {
     step_iterative();
   ++step_;
   check_stability();
-  if (step_ % 1000 == 0) save_backup();
+  // The backup is taken at the same steps on every rank, and after every rebuild so that it
+  // holds the particles this rank owns now (a rebuild may migrate them).
+  if (step_ % 1000 == 0 || builds_at_backup_ != search_.builds()) save_backup();
 }
 
 void Simulation::run_until(double t_end) {
@@ -531,7 +596,10 @@ void Simulation::step_verlet() {
   max_disp2_ = disp2;
   time_ = static_cast<double>(step_ + 1) * dt_;
   walls_.update(time_);
-  if (rebuild_needed()) rebuild();
+  if (rebuild_needed(std::sqrt(max_disp2_)))
+    rebuild();
+  else
+    domain_->refresh_ghosts(particles_, ghost_fields_);
   evaluate_forces(dt_, h, true);
   commit_history();
   account(totals_, dt_);
@@ -547,6 +615,21 @@ void Simulation::step_verlet() {
 //   x1 = x0 + v0 dt + (2 a0 + a1) dt^2 / 6,  v1 = v0 + (a0 + a1) dt / 2.
 void Simulation::step_iterative() {
   ParticleStore& p = particles_;
+  const double dt = dt_, c2 = dt * dt / 6.0;
+  time_ = static_cast<double>(step_ + 1) * dt_;
+  walls_.update(time_);
+  // The neighbour lists must hold through every pass of this step, and a rebuild (which may
+  // migrate particles between ranks) cannot happen between passes: decide it now, from the
+  // displacement since the last build plus a bound on this step's motion, |v| dt + |a| dt^2
+  // (twice the constant-acceleration travel).
+  {
+    const std::size_t n = p.n_owned();
+    double reach = 0.0;
+    for (std::size_t k = 0; k < n; ++k)
+      reach = std::max(reach, norm(p.pos[k] - pos_at_build_[k]) + norm(p.vel[k]) * dt +
+                                  norm(p.acc[k]) * dt * dt);
+    if (rebuild_needed(reach)) rebuild();
+  }
   const std::size_t n = p.n_owned();
   x0_.assign(p.pos.data(), p.pos.data() + n);
   v0_.assign(p.vel.data(), p.vel.data() + n);
@@ -554,13 +637,10 @@ void Simulation::step_iterative() {
   th0_.assign(p.theta.data(), p.theta.data() + n);
   w0_.assign(p.omega.data(), p.omega.data() + n);
   al0_.assign(p.alpha.data(), p.alpha.data() + n);
-  Array<Vec2> a1(a0_);
-  Array<double> al1(al0_);
-  const double dt = dt_, c2 = dt * dt / 6.0;
+  a1_.assign(a0_.begin(), a0_.end());
+  al1_.assign(al0_.begin(), al0_.end());
   const double eps = scene_.run.tolerance;
   const double a_ref = std::max(norm(gravity_), 1e-12);
-  time_ = static_cast<double>(step_ + 1) * dt_;
-  walls_.update(time_);
 
   auto predict = [&]() {
     Vec2* x = p.pos.data();
@@ -568,10 +648,10 @@ void Simulation::step_iterative() {
     double* th = p.theta.data();
     double* w = p.omega.data();
     for (std::size_t k = 0; k < n; ++k) {
-      x[k] = x0_[k] + dt * v0_[k] + c2 * (2.0 * a0_[k] + a1[k]);
-      v[k] = v0_[k] + (0.5 * dt) * (a0_[k] + a1[k]);
-      th[k] = th0_[k] + dt * w0_[k] + c2 * (2.0 * al0_[k] + al1[k]);
-      w[k] = w0_[k] + (0.5 * dt) * (al0_[k] + al1[k]);
+      x[k] = x0_[k] + dt * v0_[k] + c2 * (2.0 * a0_[k] + a1_[k]);
+      v[k] = v0_[k] + (0.5 * dt) * (a0_[k] + a1_[k]);
+      th[k] = th0_[k] + dt * w0_[k] + c2 * (2.0 * al0_[k] + al1_[k]);
+      w[k] = w0_[k] + (0.5 * dt) * (al0_[k] + al1_[k]);
     }
   };
 
@@ -580,36 +660,29 @@ void Simulation::step_iterative() {
   const int max_passes = std::max(1, scene_.run.max_passes);
   while (pass < max_passes && !converged) {
     predict();
-    if (pass == 0) {
-      double disp2 = max_disp2_;
-      for (std::size_t k = 0; k < n; ++k) disp2 = std::max(disp2, norm2(p.pos[k] - pos_at_build_[k]));
-      max_disp2_ = disp2;
-      if (rebuild_needed()) rebuild();
-    }
+    domain_->refresh_ghosts(particles_, ghost_fields_);
     evaluate_forces(dt);
     ++pass;
-    // Converged when |a^k - a^(k-1)| <= eps (|a^k| + a_ref) for every DOF (T31); angular
-    // accelerations are compared in units of a_ref / r.
+    // Converged when |a^k - a^(k-1)| <= eps (|a^k| + a_ref) for every DOF (T31) on every
+    // rank; angular accelerations are compared in units of a_ref / r.
     bool ok = true;
     for (std::size_t k = 0; k < n && ok; ++k) {
       const Vec2 a = p.acc[k];
       const double scale_w = 1.0 / p.radius[k];
-      ok = std::abs(a.x - a1[k].x) <= eps * (std::abs(a.x) + a_ref) &&
-           std::abs(a.y - a1[k].y) <= eps * (std::abs(a.y) + a_ref) &&
-           std::abs(p.alpha[k] - al1[k]) <= eps * (std::abs(p.alpha[k]) + a_ref * scale_w);
+      ok = std::abs(a.x - a1_[k].x) <= eps * (std::abs(a.x) + a_ref) &&
+           std::abs(a.y - a1_[k].y) <= eps * (std::abs(a.y) + a_ref) &&
+           std::abs(p.alpha[k] - al1_[k]) <= eps * (std::abs(p.alpha[k]) + a_ref * scale_w);
     }
+    ok = !domain_->any(!ok);
     for (std::size_t k = 0; k < n; ++k) {
-      a1[k] = p.acc[k];
-      al1[k] = p.alpha[k];
+      a1_[k] = p.acc[k];
+      al1_[k] = p.alpha[k];
     }
     converged = ok && pass > 1;
   }
   // Final state from the last accelerations (p.acc already holds a1 for the next step).
   predict();
   if (!converged) ++unconverged_steps_;
-  double disp2 = max_disp2_;
-  for (std::size_t k = 0; k < n; ++k) disp2 = std::max(disp2, norm2(p.pos[k] - pos_at_build_[k]));
-  max_disp2_ = disp2;
   commit_history();
   account(totals_, dt);
   last_passes_ = pass;
@@ -656,13 +729,16 @@ void Simulation::save_backup() {
   backup_vel_.assign(particles_.vel.data(), particles_.vel.data() + n);
   backup_theta_.assign(particles_.theta.data(), particles_.theta.data() + n);
   backup_omega_.assign(particles_.omega.data(), particles_.omega.data() + n);
+  backup_id_.assign(particles_.id.data(), particles_.id.data() + n);
   backup_time_ = time_;
   backup_step_ = step_;
+  builds_at_backup_ = search_.builds();
 }
 
 void Simulation::restore_backup() {
   const std::size_t n = particles_.n_owned();
-  if (backup_pos_.size() != n) return;
+  if (backup_pos_.size() != n || !std::equal(backup_id_.begin(), backup_id_.end(), particles_.id.data()))
+    return;
   std::copy(backup_pos_.begin(), backup_pos_.end(), particles_.pos.data());
   std::copy(backup_vel_.begin(), backup_vel_.end(), particles_.vel.data());
   std::copy(backup_theta_.begin(), backup_theta_.end(), particles_.theta.data());

@@ -88,6 +88,7 @@ class Simulation {
   std::int64_t step_count() const { return step_; }
   double dt() const { return dt_; }
   double skin() const { return skin_; }
+  double halo_width() const { return halo_width_; }
   const TimeScales& scales() const { return scales_; }
   const Scene& scene() const { return scene_; }
   ParticleStore& particles() { return particles_; }
@@ -123,7 +124,10 @@ class Simulation {
   void evaluate_forces(double dt_history, double kick = 0.0, bool owned_cleared = false);
   void step_verlet();
   void step_iterative();
-  bool rebuild_needed() const;
+  bool rebuild_needed(double max_displacement) const;
+  // Contact histories keyed by ids (parallel rebuilds: they travel with migrating particles).
+  std::vector<HistoryRecord> history_records() const;
+  void adopt_history_records(const std::vector<HistoryRecord>& records);
   void check_stability();
   void save_backup();
   void restore_backup();
@@ -148,6 +152,8 @@ class Simulation {
   double time_ = 0.0;
   std::int64_t step_ = 0;
   double skin_ = 0.0;
+  double halo_width_ = 0.0;
+  std::vector<FieldBase*> ghost_fields_;  // refreshed on ghosts every force evaluation
   Vec2 gravity_{};
 
   // Rebuild bookkeeping: positions and wall pose at the last build.
@@ -157,8 +163,8 @@ class Simulation {
   double max_disp2_ = 0.0;
 
   // Iterative integrator: state at the start of the step.
-  Array<Vec2> x0_, v0_, a0_;
-  Array<double> th0_, w0_, al0_;
+  Array<Vec2> x0_, v0_, a0_, a1_;
+  Array<double> th0_, w0_, al0_, al1_;
   int last_passes_ = 0;
   std::int64_t passes_total_ = 0;
   std::int64_t passes_since_row_ = 0;
@@ -174,6 +180,8 @@ class Simulation {
   // Last known good state (for the snapshot written when a run blows up).
   std::vector<Vec2> backup_pos_, backup_vel_;
   std::vector<double> backup_theta_, backup_omega_;
+  std::vector<std::int64_t> backup_id_;
+  std::int64_t builds_at_backup_ = 0;
   double backup_time_ = 0.0;
   std::int64_t backup_step_ = 0;
 };

@@ -1,12 +1,61 @@
 #include "parallel/mpi_domain.hpp"
 
-#include <vector>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
 
 namespace dem2d {
 
-MpiDomain::MpiDomain(MPI_Comm comm) : comm_(comm) {
+namespace {
+
+constexpr int kTagHalo = 7301;
+
+// Wall-clock accumulator for the time spent communicating.
+class CommTimer {
+ public:
+  explicit CommTimer(double& total) : total_(total), start_(MPI_Wtime()) {}
+  ~CommTimer() { total_ += MPI_Wtime() - start_; }
+
+ private:
+  double& total_;
+  double start_;
+};
+
+std::size_t record_bytes(const ParticleStore& p) { return p.bytes_per_particle(); }
+
+void pack_particle(const ParticleStore& p, std::size_t i, std::byte* out) {
+  for (const FieldBase* f : p.fields()) {
+    f->pack(i, out);
+    out += f->bytes_per_item();
+  }
+}
+
+void unpack_particle(ParticleStore& p, std::size_t i, const std::byte* in) {
+  for (FieldBase* f : p.fields()) {
+    f->unpack(i, in);
+    in += f->bytes_per_item();
+  }
+}
+
+// Distance from x to the ray from c along angle a.
+double distance_to_ray(Vec2 x, Vec2 c, double a) {
+  const Vec2 u{std::cos(a), std::sin(a)};
+  const Vec2 d = x - c;
+  return dot(u, d) > 0.0 ? std::abs(cross(u, d)) : norm(d);
+}
+
+}  // namespace
+
+MpiDomain::MpiDomain(MPI_Comm comm, const DecompositionOptions& options)
+    : comm_(comm), options_(options) {
   MPI_Comm_rank(comm_, &rank_);
   MPI_Comm_size(comm_, &size_);
+  if (options_.sectors_per_rank < 1) options_.sectors_per_rank = 1;
+  partition_ = partition_equal_angle(options_.sectors_per_rank * size_, size_);
+  rebuild_wedges();
 }
 
 // Sum in rank order on every rank: an MPI_Allreduce may add in any order.
@@ -34,6 +83,329 @@ bool MpiDomain::any(bool x) const {
   int in = x ? 1 : 0, out = 0;
   MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_LOR, comm_);
   return out != 0;
+}
+
+void MpiDomain::agree(const std::string& local_error) const {
+  // The lowest failing rank's message, on every rank.
+  const int mine = local_error.empty() ? size_ : rank_;
+  int first = size_;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm_);
+  if (first == size_) return;
+  int len = first == rank_ ? static_cast<int>(local_error.size()) : 0;
+  MPI_Bcast(&len, 1, MPI_INT, first, comm_);
+  std::string msg(static_cast<std::size_t>(len), ' ');
+  if (first == rank_) msg = local_error;
+  MPI_Bcast(msg.data(), len, MPI_CHAR, first, comm_);
+  throw std::runtime_error(msg);
+}
+
+int MpiDomain::owner_of(Vec2 x) const {
+  return partition_.owner[static_cast<std::size_t>(sector_of(x, options_.center, partition_.n_sectors))];
+}
+
+void MpiDomain::rebuild_wedges() {
+  wedge_begin_.resize(size_);
+  wedge_end_.resize(size_);
+  for (int q = 0; q < size_; ++q) {
+    wedge_begin_[q] = arc_begin_angle(partition_, q);
+    wedge_end_[q] = arc_end_angle(partition_, q);
+  }
+}
+
+// Sector weights (owned particles per sector) and boundary weights (particles within the halo
+// width of each boundary ray), summed over ranks: integer-valued doubles, so the sums are exact
+// in any order and every rank sees the same numbers. Rank 0 partitions and broadcasts.
+void MpiDomain::repartition(const ParticleStore& p) {
+  const int n = options_.sectors_per_rank * size_;
+  const double step = kTwoPi / n;
+  std::vector<double> weights(2 * static_cast<std::size_t>(n), 0.0);  // work, then boundaries
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    const int s = sector_of(p.pos[k], options_.center, n);
+    weights[static_cast<std::size_t>(s)] += 1.0;
+    // Boundary ray s lies between sectors s - 1 and s: edge s - 1; ray s + 1: edge s.
+    if (distance_to_ray(p.pos[k], options_.center, s * step) < halo_width_)
+      weights[static_cast<std::size_t>(n + (s + n - 1) % n)] += 1.0;
+    if (distance_to_ray(p.pos[k], options_.center, (s + 1) * step) < halo_width_)
+      weights[static_cast<std::size_t>(n + s)] += 1.0;
+  }
+  std::vector<double> total(weights.size());
+  MPI_Allreduce(weights.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  const std::span<const double> work(total.data(), static_cast<std::size_t>(n));
+  const std::span<const double> edges(total.data() + n, static_cast<std::size_t>(n));
+  std::vector<int> owner(static_cast<std::size_t>(n));
+  std::string method;
+  if (rank_ == 0) {
+    const SectorPartition part = partition_metis(work, edges, size_);
+    owner = part.owner;
+    method = part.method;
+  }
+  MPI_Bcast(owner.data(), n, MPI_INT, 0, comm_);
+  int len = static_cast<int>(method.size());
+  MPI_Bcast(&len, 1, MPI_INT, 0, comm_);
+  method.resize(static_cast<std::size_t>(len));
+  MPI_Bcast(method.data(), len, MPI_CHAR, 0, comm_);
+  // Arcs in canonical order from the owner vector: part q starts where its predecessor differs.
+  SectorPartition part;
+  part.n_sectors = n;
+  part.owner = owner;
+  part.method = method;
+  part.arcs.assign(static_cast<std::size_t>(size_), Arc{});
+  for (int s = 0; s < n; ++s) {
+    const int q = owner[static_cast<std::size_t>(s)];
+    part.arcs[static_cast<std::size_t>(q)].count += 1;
+    if (owner[static_cast<std::size_t>((s + n - 1) % n)] != q) part.arcs[static_cast<std::size_t>(q)].first = s;
+  }
+  if (!is_valid(part)) throw std::logic_error("MpiDomain: the sector partition is not one arc per rank");
+  partition_ = std::move(part);
+  rebuild_wedges();
+  stats_.partitions += 1;
+  stats_.method = method;
+  stats_.imbalance_partition = imbalance(work, partition_);
+  stats_.imbalance_equal_angle = imbalance(work, partition_equal_angle(n, size_));
+  repartition_due_ = false;
+  rebuilds_since_partition_ = 0;
+}
+
+void MpiDomain::adopt(ParticleStore& p, double halo_width) {
+  CommTimer timer(stats_.comm_seconds);
+  halo_width_ = halo_width;
+  p.clear_ghosts();
+  total_particles_ = static_cast<std::int64_t>(p.n_owned());
+  if (!options_.has_center) {
+    // No drum: the centre of the particles' bounding box (every rank holds every particle).
+    Vec2 lo{1e300, 1e300}, hi{-1e300, -1e300};
+    for (std::size_t k = 0; k < p.n_owned(); ++k) {
+      lo = {std::min(lo.x, p.pos[k].x), std::min(lo.y, p.pos[k].y)};
+      hi = {std::max(hi.x, p.pos[k].x), std::max(hi.y, p.pos[k].y)};
+    }
+    options_.center = p.n_owned() ? 0.5 * (lo + hi) : Vec2{};
+    options_.has_center = true;
+  }
+  // Every rank holds every particle: only rank 0 contributes to the (summed) sector weights.
+  if (rank_ == 0) {
+    repartition(p);
+  } else {
+    const ParticleStore none;
+    repartition(none);
+  }
+  std::vector<char> drop(p.n_owned(), 0);
+  for (std::size_t k = 0; k < p.n_owned(); ++k) drop[k] = owner_of(p.pos[k]) != rank_ ? 1 : 0;
+  p.remove_if(drop);
+  if (sum(static_cast<std::int64_t>(p.n_owned())) != total_particles_)
+    throw std::logic_error("MpiDomain::adopt: particles lost or duplicated");
+}
+
+void MpiDomain::report_work(double work) {
+  stats_.work = work;
+  double in[2] = {work, -work}, out[2] = {0.0, 0.0};
+  MPI_Allreduce(in, out, 2, MPI_DOUBLE, MPI_MAX, comm_);
+  const double total = sum(work);
+  const double mean = total / size_;
+  stats_.imbalance_work = mean > 0.0 ? out[0] / mean : 1.0;
+  ++rebuilds_since_partition_;
+  repartition_due_ = stats_.imbalance_work > options_.repartition_threshold &&
+                     rebuilds_since_partition_ >= options_.repartition_gap;
+}
+
+std::vector<double> MpiDomain::gather_work() const {
+  std::vector<double> all(static_cast<std::size_t>(size_));
+  MPI_Allgather(&stats_.work, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_);
+  return all;
+}
+
+void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) {
+  CommTimer timer(stats_.comm_seconds);
+  p.clear_ghosts();
+  const bool repartitioned = repartition_due_;
+  if (repartitioned) repartition(p);
+  const std::size_t n = p.n_owned();
+  std::vector<int> dest(n);
+  std::vector<char> leaving(n, 0);
+  std::ostringstream error;
+  for (std::size_t k = 0; k < n; ++k) {
+    dest[k] = owner_of(p.pos[k]);
+    if (dest[k] == rank_) continue;
+    leaving[k] = 1;
+    // Without a repartition a particle leaves only by crossing into a neighbour's wedge: it
+    // was a ghost there if it is still within the halo width of this rank's wedge.
+    if (!repartitioned && error.tellp() == 0) {
+      const double d = distance_to_wedge(p.pos[k], options_.center, wedge_begin_[rank_], wedge_end_[rank_]);
+      if (d > halo_width_)
+        error << "particle " << p.id[k] << " moved " << d << " m beyond the region of rank " << rank_
+              << " between two neighbour rebuilds (more than the halo width " << halo_width_
+              << " m): the time step is far too large or the particle left the scene";
+    }
+  }
+  agree(error.str());
+
+  // Particles and their histories, per destination rank.
+  const std::size_t bpp = record_bytes(p);
+  std::vector<std::vector<std::byte>> send_particles(static_cast<std::size_t>(size_));
+  std::vector<std::vector<HistoryRecord>> send_records(static_cast<std::size_t>(size_));
+  std::unordered_map<std::int64_t, int> dest_of_leaving;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!leaving[k]) continue;
+    auto& buf = send_particles[static_cast<std::size_t>(dest[k])];
+    const std::size_t at = buf.size();
+    buf.resize(at + bpp);
+    pack_particle(p, k, buf.data() + at);
+    dest_of_leaving.emplace(p.id[k], dest[k]);
+  }
+  for (const HistoryRecord& r : histories) {
+    int da = -1, db = -1;
+    if (auto it = dest_of_leaving.find(r.a); it != dest_of_leaving.end()) da = it->second;
+    if (r.b >= 0)
+      if (auto it = dest_of_leaving.find(r.b); it != dest_of_leaving.end()) db = it->second;
+    if (da >= 0) send_records[static_cast<std::size_t>(da)].push_back(r);
+    if (db >= 0 && db != da) send_records[static_cast<std::size_t>(db)].push_back(r);
+  }
+  stats_.migrated += static_cast<std::int64_t>(dest_of_leaving.size());
+
+  // Counts, then the bytes (particles and records in one all-to-all each).
+  const auto exchange = [&](const std::vector<std::vector<std::byte>>& out) {
+    std::vector<long long> send_n(static_cast<std::size_t>(size_)), recv_n(static_cast<std::size_t>(size_));
+    for (int q = 0; q < size_; ++q) send_n[static_cast<std::size_t>(q)] = static_cast<long long>(out[static_cast<std::size_t>(q)].size());
+    MPI_Alltoall(send_n.data(), 1, MPI_LONG_LONG, recv_n.data(), 1, MPI_LONG_LONG, comm_);
+    std::vector<int> sc(static_cast<std::size_t>(size_)), sd(static_cast<std::size_t>(size_)),
+        rc(static_cast<std::size_t>(size_)), rd(static_cast<std::size_t>(size_));
+    std::vector<std::byte> flat_send, flat_recv;
+    for (int q = 0; q < size_; ++q) {
+      const std::size_t u = static_cast<std::size_t>(q);
+      sd[u] = static_cast<int>(flat_send.size());
+      sc[u] = static_cast<int>(send_n[u]);
+      flat_send.insert(flat_send.end(), out[u].begin(), out[u].end());
+    }
+    std::size_t total = 0;
+    for (int q = 0; q < size_; ++q) {
+      const std::size_t u = static_cast<std::size_t>(q);
+      rd[u] = static_cast<int>(total);
+      rc[u] = static_cast<int>(recv_n[u]);
+      total += static_cast<std::size_t>(recv_n[u]);
+    }
+    flat_recv.resize(total);
+    MPI_Alltoallv(flat_send.data(), sc.data(), sd.data(), MPI_BYTE, flat_recv.data(), rc.data(), rd.data(),
+                  MPI_BYTE, comm_);
+    return flat_recv;
+  };
+  const std::vector<std::byte> arrived = exchange(send_particles);
+  std::vector<std::vector<std::byte>> record_bytes_out(static_cast<std::size_t>(size_));
+  for (int q = 0; q < size_; ++q) {
+    const auto& rs = send_records[static_cast<std::size_t>(q)];
+    auto& b = record_bytes_out[static_cast<std::size_t>(q)];
+    b.resize(rs.size() * sizeof(HistoryRecord));
+    if (!rs.empty()) std::memcpy(b.data(), rs.data(), b.size());
+  }
+  const std::vector<std::byte> arrived_records = exchange(record_bytes_out);
+
+  // Drop the leavers, append the arrivals, keep the owned particles in id order.
+  p.remove_if(leaving);
+  const std::size_t n_new = arrived.size() / bpp;
+  const std::size_t first = p.add_owned(n_new);
+  for (std::size_t k = 0; k < n_new; ++k) unpack_particle(p, first + k, arrived.data() + k * bpp);
+  if (!std::is_sorted(p.id.data(), p.id.data() + p.n_owned())) {
+    std::vector<std::size_t> order(p.n_owned());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+    p.permute(order);
+  }
+  const std::size_t n_rec = arrived_records.size() / sizeof(HistoryRecord);
+  const std::size_t had = histories.size();
+  histories.resize(had + n_rec);
+  if (n_rec) std::memcpy(static_cast<void*>(histories.data() + had), arrived_records.data(), n_rec * sizeof(HistoryRecord));
+  std::sort(histories.begin(), histories.end());
+  histories.erase(std::unique(histories.begin(), histories.end(),
+                              [](const HistoryRecord& x, const HistoryRecord& y) { return x.a == y.a && x.b == y.b; }),
+                  histories.end());
+
+  const std::int64_t total = sum(static_cast<std::int64_t>(p.n_owned()));
+  if (total != total_particles_) {
+    std::ostringstream o;
+    o << "migration lost or duplicated particles: " << total << " owned after it, " << total_particles_
+      << " before (rank count " << size_ << ")";
+    throw std::logic_error(o.str());
+  }
+}
+
+void MpiDomain::transport(const Plan& plan, std::size_t bytes_per_item,
+                          const std::vector<std::vector<std::byte>>& send,
+                          std::vector<std::vector<std::byte>>& recv) {
+  const std::size_t np = plan.peers.size();
+  recv.resize(np);
+  std::vector<MPI_Request> req;
+  req.reserve(2 * np);
+  for (std::size_t u = 0; u < np; ++u) {
+    recv[u].resize(plan.recv_count[u] * bytes_per_item);
+    if (recv[u].empty()) continue;
+    req.emplace_back();
+    MPI_Irecv(recv[u].data(), static_cast<int>(recv[u].size()), MPI_BYTE, plan.peers[u], kTagHalo, comm_,
+              &req.back());
+  }
+  for (std::size_t u = 0; u < np; ++u) {
+    if (send[u].empty()) continue;
+    req.emplace_back();
+    MPI_Isend(send[u].data(), static_cast<int>(send[u].size()), MPI_BYTE, plan.peers[u], kTagHalo, comm_,
+              &req.back());
+  }
+  MPI_Waitall(static_cast<int>(req.size()), req.data(), MPI_STATUSES_IGNORE);
+}
+
+void MpiDomain::exchange_halo(ParticleStore& p) {
+  CommTimer timer(stats_.comm_seconds);
+  p.clear_ghosts();
+  // Who needs which of my particles: every other rank whose wedge is within the halo width.
+  std::vector<std::vector<std::int32_t>> to(static_cast<std::size_t>(size_));
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    for (int q = 0; q < size_; ++q)
+      if (q != rank_ && distance_to_wedge(p.pos[k], options_.center, wedge_begin_[q], wedge_end_[q]) < halo_width_)
+        to[static_cast<std::size_t>(q)].push_back(static_cast<std::int32_t>(k));
+  std::vector<long long> send_n(static_cast<std::size_t>(size_)), recv_n(static_cast<std::size_t>(size_));
+  for (int q = 0; q < size_; ++q) send_n[static_cast<std::size_t>(q)] = static_cast<long long>(to[static_cast<std::size_t>(q)].size());
+  MPI_Alltoall(send_n.data(), 1, MPI_LONG_LONG, recv_n.data(), 1, MPI_LONG_LONG, comm_);
+  halo_ = Plan{};
+  for (int q = 0; q < size_; ++q) {
+    const std::size_t u = static_cast<std::size_t>(q);
+    if (q == rank_ || (send_n[u] == 0 && recv_n[u] == 0)) continue;
+    halo_.peers.push_back(q);
+    halo_.send.push_back(std::move(to[u]));
+    halo_.recv_count.push_back(static_cast<std::size_t>(recv_n[u]));
+  }
+  std::vector<FieldBase*> all(p.fields().begin(), p.fields().end());
+  std::size_t n_ghost = 0;
+  for (std::size_t c : halo_.recv_count) n_ghost += c;
+  p.add_ghosts(n_ghost);
+  fill_ghosts(p, all);
+  stats_.ghosts = static_cast<std::int64_t>(n_ghost);
+}
+
+void MpiDomain::refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) {
+  CommTimer timer(stats_.comm_seconds);
+  fill_ghosts(p, fields);
+}
+
+void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) {
+  std::size_t bpi = 0;
+  for (const FieldBase* f : fields) bpi += f->bytes_per_item();
+  const std::size_t np = halo_.peers.size();
+  std::vector<std::vector<std::byte>> send(np), recv;
+  for (std::size_t u = 0; u < np; ++u) {
+    send[u].resize(halo_.send[u].size() * bpi);
+    std::byte* out = send[u].data();
+    for (const std::int32_t k : halo_.send[u])
+      for (const FieldBase* f : fields) {
+        f->pack(static_cast<std::size_t>(k), out);
+        out += f->bytes_per_item();
+      }
+  }
+  transport(halo_, bpi, send, recv);
+  std::size_t slot = p.n_owned();
+  for (std::size_t u = 0; u < np; ++u) {
+    const std::byte* in = recv[u].data();
+    for (std::size_t c = 0; c < halo_.recv_count[u]; ++c, ++slot)
+      for (FieldBase* f : fields) {
+        f->unpack(slot, in);
+        in += f->bytes_per_item();
+      }
+  }
 }
 
 }  // namespace dem2d

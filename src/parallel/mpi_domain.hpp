@@ -1,18 +1,72 @@
-// MpiDomain: the Domain verbs over MPI. Today: reductions only, which are exact (max, logical
-// or, integer sums) or order-fixed (double sums gathered and added in rank order), so they
-// give the same bits on every rank. The angular-sector decomposition (migrate, exchange_halo,
-// refresh_ghosts) is issue 3.
+// MpiDomain: the Domain verbs over MPI with the angular-sector decomposition
+// (architecture.md, Decomposition).
+//
+// Regions. The plane is cut into n thin angular sectors about the drum centre (the scene
+// centre without a drum), sector_of() in parallel/sector_partition.hpp. METIS groups them into
+// one contiguous arc per rank, weighted by the particles in each sector (edges: particles near
+// the common boundary). A rank's region is the wedge of its arc.
+//
+// Ownership and ghosts. A particle belongs to the rank whose wedge holds its centre, decided
+// at neighbour rebuilds only (between rebuilds a particle may drift a little past its wedge:
+// the Verlet skin covers that). It is a ghost on every other rank whose wedge lies within the
+// halo width (2 r_max + skin) of it as a true distance (distance_to_wedge), which stays right
+// at the drum centre, where all wedges meet, and for wedges wider than pi.
+//
+// Plans and transport. A plan lists, per neighbour rank, the local indices to send and the
+// number to receive; the transport moves the bytes of any set of registered fields for a plan
+// (FieldBase::pack/unpack), so one plan serves every field: the halo plan is built at each
+// rebuild and reused by refresh_ghosts every force evaluation. Migration carries every
+// registered field and the contact histories of the particles that move.
+//
+// Checks. A particle that left its region by more than the halo width since the last
+// rebuild (it jumped past the ghosts of its new owner) is a hard error naming it; the global
+// particle count is compared before and after every migration. Errors are agreed on: every
+// rank throws the same message.
+//
+// Load balance. After each rebuild the core reports its work (owned particles + listed pairs);
+// when max/mean over ranks exceeds `repartition_threshold` and at least `repartition_gap`
+// rebuilds passed since the last partition (hysteresis), the next migrate() repartitions.
+//
+// Reductions are exact (max, logical or, integer sums) or order-fixed (double sums gathered and
+// added in rank order), so they give the same bits on every rank.
 #pragma once
 
 #include <mpi.h>
 
+#include <cstdint>
+#include <string>
+#include <vector>
+
 #include "core/domain.hpp"
+#include "core/vec2.hpp"
+#include "parallel/sector_partition.hpp"
 
 namespace dem2d {
 
+struct DecompositionOptions {
+  Vec2 center{};                      // sectors are cut about this point (the drum centre)
+  bool has_center = false;            // false: the centre of the particles' bounding box
+  int sectors_per_rank = 16;
+  double repartition_threshold = 1.2; // max/mean work that triggers a repartition
+  int repartition_gap = 10;           // rebuilds between two partitions at least
+};
+
+// What the decomposition did, for run.json and bench/strong_scaling.
+struct DecompositionStats {
+  int partitions = 0;                 // METIS partitions computed (1 = the initial one)
+  std::string method;                 // how the last partition was found
+  double imbalance_work = 1.0;        // max/mean of the last reported work
+  double imbalance_equal_angle = 1.0; // the same for equal-angle arcs at the last partition
+  double imbalance_partition = 1.0;   // predicted (sector weights) at the last partition
+  std::int64_t migrated = 0;          // particles sent by this rank, all rebuilds
+  std::int64_t ghosts = 0;            // ghosts on this rank after the last halo exchange
+  double comm_seconds = 0.0;          // wall time in migrate / exchange_halo / refresh_ghosts
+  double work = 0.0;                  // this rank's last reported work
+};
+
 class MpiDomain final : public Domain {
  public:
-  explicit MpiDomain(MPI_Comm comm);
+  MpiDomain(MPI_Comm comm, const DecompositionOptions& options = {});
   int rank() const override { return rank_; }
   int size() const override { return size_; }
   double sum(double x) const override;
@@ -20,10 +74,49 @@ class MpiDomain final : public Domain {
   std::int64_t sum(std::int64_t x) const override;
   bool any(bool x) const override;
 
+  void adopt(ParticleStore& p, double halo_width) override;
+  void migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) override;
+  void exchange_halo(ParticleStore& p) override;
+  void refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) override;
+  void report_work(double work) override;
+
+  const SectorPartition& partition() const { return partition_; }
+  // The rank owning a point (its sector's part).
+  int owner_of(Vec2 x) const;
+  double halo_width() const { return halo_width_; }
+  const DecompositionStats& stats() const { return stats_; }
+  // Every rank's stats.work, gathered (collective).
+  std::vector<double> gather_work() const;
+
  private:
+  // Who sends what to whom: per peer rank, local indices to send and the count to receive.
+  struct Plan {
+    std::vector<int> peers;                  // ranks exchanged with, ascending
+    std::vector<std::vector<std::int32_t>> send;  // per peer: local indices
+    std::vector<std::size_t> recv_count;     // per peer
+  };
+  void repartition(const ParticleStore& p);
+  void rebuild_wedges();
+  void fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields);
+  // Point-to-point exchange of one plan's bytes: `bytes_per_item` per listed index.
+  void transport(const Plan& plan, std::size_t bytes_per_item,
+                 const std::vector<std::vector<std::byte>>& send,
+                 std::vector<std::vector<std::byte>>& recv);
+  // Collective: throws std::runtime_error with the first failing rank's message on every rank.
+  void agree(const std::string& local_error) const;
+
   MPI_Comm comm_;
   int rank_ = 0;
   int size_ = 1;
+  DecompositionOptions options_;
+  SectorPartition partition_;
+  std::vector<double> wedge_begin_, wedge_end_;  // per rank, radians
+  double halo_width_ = 0.0;
+  std::int64_t total_particles_ = 0;
+  Plan halo_;
+  bool repartition_due_ = false;
+  int rebuilds_since_partition_ = 0;
+  DecompositionStats stats_;
 };
 
 }  // namespace dem2d
