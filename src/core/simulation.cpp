@@ -40,127 +40,139 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   ContactHistory* trial = pl.trial.data();
   const int n_mat = table.n_materials();
 
-  // A. Gather the pairs in contact; pairs apart lose their history. Branch-free compaction:
-  //    every candidate is written to slot n and n advances only for a contact (whether a
-  //    candidate touches is close to random, so a branch here mispredicts often).
-  const std::size_t n_pairs = pl.size();
-  b.reserve(n_pairs + kPackSize);
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < n_pairs; ++k) {
-    const std::int32_t i = pi[k], j = pj[k];
-    const Vec2 d = x[j] - x[i];
-    const double dist2 = norm2(d);
-    const double rsum = r[i] + r[j];
-    trial[k] = ContactHistory{};  // overwritten by the scatter for the pairs in contact
-    b.pair[n] = static_cast<std::int32_t>(k);
-    b.dx[n] = d.x;
-    b.dy[n] = d.y;
-    b.dist2[n] = dist2;
-    // Written so that a NaN distance counts as a contact: its NaN forces are then caught by
-    // check_stability instead of the particle silently dropping out of every contact.
-    n += !(dist2 >= rsum * rsum) ? 1 : 0;
-  }
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t k = b.pair[c];
-    const std::int32_t i = pi[k], j = pj[k];
-    b.coeff[c] = mat[i] * n_mat + mat[j];
-    b.r_i[c] = r[i];
-    b.r_j[c] = r[j];
-    b.m_i[c] = m[i];
-    b.m_j[c] = m[j];
-    b.vx[c] = v[i].x - v[j].x;
-    b.vy[c] = v[i].y - v[j].y;
-    b.spin[c] = w[i] * r[i] + w[j] * r[j];
-    b.omega_rel[c] = w[i] - w[j];
-    b.xi_old[c] = hist[k].xi;
-    b.mr_old[c] = hist[k].m_roll;
-  }
-  const std::size_t n_padded = (n + kPackSize - 1) / kPackSize * kPackSize;
-  for (std::size_t c = n; c < n_padded; ++c) b.copy(c, n - 1);
-
-  // B. Kinematics and the contact law, kPackSize contacts at a time.
   const PairCoeffs* coeffs = table.data();
   const bool uniform = n_mat == 1;
   const CoeffPack uniform_coeffs(coeffs[0]);
-  Pack dissipated(0.0), elastic(0.0), max_overlap(0.0);
+  Pack dissipated(0.0), elastic(0.0);
   const auto load = [](const Array<double>& a, std::size_t c) {
     return Pack(a.data() + c, stdx::element_aligned);
   };
-  for (std::size_t c = 0; c < n_padded; c += kPackSize) {
-    const Pack dist = vsqrt(load(b.dist2, c));
-    const Pack inv = 1.0 / dist;
-    const Pack nx = inv * load(b.dx, c), ny = inv * load(b.dy, c);
-    const Pack tx = -ny, ty = nx;
-    const Pack ri = load(b.r_i, c), rj = load(b.r_j, c);
-    const Pack mi = load(b.m_i, c), mj = load(b.m_j, c);
-    const Pack rsum = ri + rj;
-    KinematicsT<Pack> kin;
-    kin.delta = rsum - dist;
-    kin.r_eff = ri * rj / rsum;
-    kin.m_eff = mi * mj / (mi + mj);
-    if constexpr (Rolling::kNeedsInertia) {
-      // I + m r^2 = 7/5 m r^2 about the contact point; harmonic mean of the two bodies.
-      const Pack ia = 1.4 * mi * ri * ri, ib = 1.4 * mj * rj * rj;
-      kin.i_eff = ia * ib / (ia + ib);
+  // The candidates are processed in chunks, each through phases A, B and C, so that the
+  // batch arrays stay in the L1/L2 cache (one pass over a batch of every contact streamed
+  // 20 arrays through memory: 1.7x slower per particle-step at 1e5 particles). Chunks run in
+  // list order, so the scatter stays canonical.
+  constexpr std::size_t kChunk = 512;
+  const std::size_t n_pairs = pl.size();
+  b.reserve(kChunk + kPackSize);
+  double max_ratio = 0.0;
+  std::int64_t contacts = 0;
+  for (std::size_t k0 = 0; k0 < n_pairs; k0 += kChunk) {
+    const std::size_t k1 = std::min(n_pairs, k0 + kChunk);
+    Pack chunk_overlap(0.0);
+    // A. Gather the pairs in contact; pairs apart lose their history. Branch-free compaction:
+    //    every candidate is written to slot n and n advances only for a contact (whether a
+    //    candidate touches is close to random, so a branch here mispredicts often).
+    std::size_t n = 0;
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::int32_t i = pi[k], j = pj[k];
+      const Vec2 d = x[j] - x[i];
+      const double dist2 = norm2(d);
+      const double rsum = r[i] + r[j];
+      trial[k] = ContactHistory{};  // overwritten by the scatter for the pairs in contact
+      b.pair[n] = static_cast<std::int32_t>(k);
+      b.dx[n] = d.x;
+      b.dy[n] = d.y;
+      b.dist2[n] = dist2;
+      // Written so that a NaN distance counts as a contact: its NaN forces are then caught by
+      // check_stability instead of the particle silently dropping out of every contact.
+      n += !(dist2 >= rsum * rsum) ? 1 : 0;
     }
-    const Pack spin = load(b.spin, c);
-    const Pack vrx = load(b.vx, c) + spin * tx, vry = load(b.vy, c) + spin * ty;
-    kin.v_n = vrx * nx + vry * ny;
-    kin.v_t = vrx * tx + vry * ty;
-    kin.omega_rel = load(b.omega_rel, c);
-    const HistoryT<Pack> old{load(b.xi_old, c), load(b.mr_old, c)};
-    HistoryT<Pack> h;
-    const CoeffPack pc = uniform ? uniform_coeffs
-                                 : CoeffPack(coeffs, [&](auto l) { return b.coeff[c + l]; });
-    const ContactForceT<Pack> cf = Model::evaluate(pc, kin, old, h, dt);
-    const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
-    const Pack arm_i = Model::kTorqueArmIsReff ? kin.r_eff : ri;
-    const Pack arm_j = Model::kTorqueArmIsReff ? kin.r_eff : rj;
-    Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
-    Pack diss = cf.dissipated, el = cf.elastic;
-    if constexpr (Rolling::kActive) {
-      const RollingTorqueT<Pack> rt = Rolling::evaluate(pc, kin, cf, old, h, dt, eta_r);
-      ti += rt.torque;
-      tj -= rt.torque;
-      diss += rt.dissipated;
-      el += rt.elastic;
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::int32_t k = b.pair[c];
+      const std::int32_t i = pi[k], j = pj[k];
+      b.coeff[c] = mat[i] * n_mat + mat[j];
+      b.r_i[c] = r[i];
+      b.r_j[c] = r[j];
+      b.m_i[c] = m[i];
+      b.m_j[c] = m[j];
+      b.vx[c] = v[i].x - v[j].x;
+      b.vy[c] = v[i].y - v[j].y;
+      b.spin[c] = w[i] * r[i] + w[j] * r[j];
+      b.omega_rel[c] = w[i] - w[j];
+      b.xi_old[c] = hist[k].xi;
+      b.mr_old[c] = hist[k].m_roll;
     }
-    const Pack ratio = kin.delta / vmin(ri, rj);
-    // Padding lanes repeat the last contact: keep them out of the sums.
-    const PackMask real = Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n);
-    dissipated += select(real, diss, Pack(0.0));
-    elastic += select(real, el, Pack(0.0));
-    max_overlap = vmax(max_overlap, ratio);
-    fx.copy_to(b.fx.data() + c, stdx::element_aligned);
-    fy.copy_to(b.fy.data() + c, stdx::element_aligned);
-    ti.copy_to(b.t_i.data() + c, stdx::element_aligned);
-    tj.copy_to(b.t_j.data() + c, stdx::element_aligned);
-    h.xi.copy_to(b.xi_new.data() + c, stdx::element_aligned);
-    h.m_roll.copy_to(b.mr_new.data() + c, stdx::element_aligned);
-    ratio.copy_to(b.overlap.data() + c, stdx::element_aligned);
-  }
+    const std::size_t n_padded = (n + kPackSize - 1) / kPackSize * kPackSize;
+    for (std::size_t c = n; c < n_padded; ++c) b.copy(c, n - 1);
 
-  // C. Scatter in canonical pair order.
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t k = b.pair[c];
-    const std::int32_t i = pi[k], j = pj[k];
-    const Vec2 fi{b.fx[c], b.fy[c]};
-    f[i] += fi;
-    f[j] -= fi;
-    tq[i] += b.t_i[c];
-    tq[j] += b.t_j[c];
-    trial[k] = ContactHistory{b.xi_new[c], b.mr_new[c]};
-  }
-  double max_ratio = stdx::hmax(max_overlap);
-  std::int64_t contacts = static_cast<std::int64_t>(n);
-  if (max_ratio > kMaxOverlapRatio) {
-    for (std::size_t c = 0; c < n; ++c)
-      if (b.overlap[c] == max_ratio) {
-        tot.worst_a = p.id[pi[b.pair[c]]];
-        tot.worst_b = p.id[pj[b.pair[c]]];
-        break;
+    for (std::size_t c = 0; c < n_padded; c += kPackSize) {
+      const Pack dist = vsqrt(load(b.dist2, c));
+      const Pack inv = 1.0 / dist;
+      const Pack nx = inv * load(b.dx, c), ny = inv * load(b.dy, c);
+      const Pack tx = -ny, ty = nx;
+      const Pack ri = load(b.r_i, c), rj = load(b.r_j, c);
+      const Pack mi = load(b.m_i, c), mj = load(b.m_j, c);
+      const Pack rsum = ri + rj;
+      KinematicsT<Pack> kin;
+      kin.delta = rsum - dist;
+      kin.r_eff = ri * rj / rsum;
+      kin.m_eff = mi * mj / (mi + mj);
+      if constexpr (Rolling::kNeedsInertia) {
+        // I + m r^2 = 7/5 m r^2 about the contact point; harmonic mean of the two bodies.
+        const Pack ia = 1.4 * mi * ri * ri, ib = 1.4 * mj * rj * rj;
+        kin.i_eff = ia * ib / (ia + ib);
       }
-  }
+      const Pack spin = load(b.spin, c);
+      const Pack vrx = load(b.vx, c) + spin * tx, vry = load(b.vy, c) + spin * ty;
+      kin.v_n = vrx * nx + vry * ny;
+      kin.v_t = vrx * tx + vry * ty;
+      kin.omega_rel = load(b.omega_rel, c);
+      const HistoryT<Pack> old{load(b.xi_old, c), load(b.mr_old, c)};
+      HistoryT<Pack> h;
+      const CoeffPack pc = uniform ? uniform_coeffs
+                                   : CoeffPack(coeffs, [&](auto l) { return b.coeff[c + l]; });
+      const ContactForceT<Pack> cf = Model::evaluate(pc, kin, old, h, dt);
+      const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
+      const Pack arm_i = Model::kTorqueArmIsReff ? kin.r_eff : ri;
+      const Pack arm_j = Model::kTorqueArmIsReff ? kin.r_eff : rj;
+      Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
+      Pack diss = cf.dissipated, el = cf.elastic;
+      if constexpr (Rolling::kActive) {
+        const RollingTorqueT<Pack> rt = Rolling::evaluate(pc, kin, cf, old, h, dt, eta_r);
+        ti += rt.torque;
+        tj -= rt.torque;
+        diss += rt.dissipated;
+        el += rt.elastic;
+      }
+      const Pack ratio = kin.delta / vmin(ri, rj);
+      // Padding lanes repeat the last contact: keep them out of the sums.
+      const PackMask real = Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n);
+      dissipated += select(real, diss, Pack(0.0));
+      elastic += select(real, el, Pack(0.0));
+      chunk_overlap = vmax(chunk_overlap, ratio);
+      fx.copy_to(b.fx.data() + c, stdx::element_aligned);
+      fy.copy_to(b.fy.data() + c, stdx::element_aligned);
+      ti.copy_to(b.t_i.data() + c, stdx::element_aligned);
+      tj.copy_to(b.t_j.data() + c, stdx::element_aligned);
+      h.xi.copy_to(b.xi_new.data() + c, stdx::element_aligned);
+      h.m_roll.copy_to(b.mr_new.data() + c, stdx::element_aligned);
+      ratio.copy_to(b.overlap.data() + c, stdx::element_aligned);
+    }
+
+    // C. Scatter in canonical pair order.
+    for (std::size_t c = 0; c < n; ++c) {
+      const std::int32_t k = b.pair[c];
+      const std::int32_t i = pi[k], j = pj[k];
+      const Vec2 fi{b.fx[c], b.fy[c]};
+      f[i] += fi;
+      f[j] -= fi;
+      tq[i] += b.t_i[c];
+      tq[j] += b.t_j[c];
+      trial[k] = ContactHistory{b.xi_new[c], b.mr_new[c]};
+    }
+    contacts += static_cast<std::int64_t>(n);
+    // The first pair at the largest overlap so far names the culprits of a blow-up.
+    const double chunk_max = stdx::hmax(chunk_overlap);
+    if (chunk_max > kMaxOverlapRatio && chunk_max > max_ratio) {
+      for (std::size_t c = 0; c < n; ++c)
+        if (b.overlap[c] == chunk_max) {
+          tot.worst_a = p.id[pi[b.pair[c]]];
+          tot.worst_b = p.id[pj[b.pair[c]]];
+          break;
+        }
+    }
+    max_ratio = std::max(max_ratio, chunk_max);
+}
   double dissipated_sum = stdx::reduce(dissipated), elastic_sum = stdx::reduce(elastic);
 
   // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel. The
