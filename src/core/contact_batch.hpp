@@ -30,6 +30,7 @@ struct ContactBatch {
   Array<double> spin;         // w_i r_i + w_j r_j
   Array<double> omega_rel;    // w_i - w_j
   Array<double> xi_old, mr_old;
+  Array<double> counted;      // 1: this rank books the contact's energies and count, 0: not
   // Outputs (phase B).
   Array<double> fx, fy;       // force on i (on j: the opposite)
   Array<double> t_i, t_j;     // torques on i and on j
@@ -39,7 +40,7 @@ struct ContactBatch {
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
     for (auto* v : {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
-                    &xi_old, &mr_old, &fx, &fy, &t_i, &t_j, &xi_new, &mr_new, &overlap})
+                    &xi_old, &mr_old, &counted, &fx, &fy, &t_i, &t_j, &xi_new, &mr_new, &overlap})
       v->resize(n);
     pair.resize(n);
     coeff.resize(n);
@@ -47,7 +48,7 @@ struct ContactBatch {
   // Copy contact `from` into slot `to` (padding).
   void copy(std::size_t to, std::size_t from) {
     for (auto* v : {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
-                    &xi_old, &mr_old})
+                    &xi_old, &mr_old, &counted})
       (*v)[to] = (*v)[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];

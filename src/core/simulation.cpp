@@ -39,6 +39,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   const ContactHistory* hist = pl.history.data();
   ContactHistory* trial = pl.trial.data();
   const int n_mat = table.n_materials();
+  const std::size_t n_owned = p.n_owned();
 
   const PairCoeffs* coeffs = table.data();
   const bool uniform = n_mat == 1;
@@ -81,6 +82,9 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
       const std::int32_t k = b.pair[c];
       const std::int32_t i = pi[k], j = pj[k];
       b.coeff[c] = mat[i] * n_mat + mat[j];
+      // A pair across a rank boundary is computed on both ranks; its energies and its count
+      // go to the rank that owns the lower-id particle (i) only.
+      b.counted[c] = static_cast<std::size_t>(i) < n_owned ? 1.0 : 0.0;
       b.r_i[c] = r[i];
       b.r_j[c] = r[j];
       b.m_i[c] = m[i];
@@ -136,7 +140,8 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
       }
       const Pack ratio = kin.delta / vmin(ri, rj);
       // Padding lanes repeat the last contact: keep them out of the sums.
-      const PackMask real = Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n);
+      const PackMask real = Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
+                            load(b.counted, c) > 0.5;
       dissipated += select(real, diss, Pack(0.0));
       elastic += select(real, el, Pack(0.0));
       chunk_overlap = vmax(chunk_overlap, ratio);
@@ -160,7 +165,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
       tq[j] += b.t_j[c];
       trial[k] = ContactHistory{b.xi_new[c], b.mr_new[c]};
     }
-    contacts += static_cast<std::int64_t>(n);
+    for (std::size_t c = 0; c < n; ++c) contacts += b.counted[c] > 0.5 ? 1 : 0;
     // The first pair at the largest overlap so far names the culprits of a blow-up.
     const double chunk_max = stdx::hmax(chunk_overlap);
     if (chunk_max > kMaxOverlapRatio && chunk_max > max_ratio) {

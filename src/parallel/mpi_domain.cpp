@@ -207,6 +207,12 @@ void MpiDomain::report_work(double work) {
                      rebuilds_since_partition_ >= options_.repartition_gap;
 }
 
+std::vector<int> MpiDomain::ghost_origin() const {
+  std::vector<int> out;
+  for (std::size_t u = 0; u < halo_.peers.size(); ++u) out.insert(out.end(), halo_.recv_count[u], halo_.peers[u]);
+  return out;
+}
+
 std::vector<double> MpiDomain::gather_work() const {
   std::vector<double> all(static_cast<std::size_t>(size_));
   MPI_Allgather(&stats_.work, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_);

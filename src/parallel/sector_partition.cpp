@@ -17,11 +17,11 @@ namespace {
 constexpr double kVertexScale = 1.0e6;  // METIS vertex weights sum to about this
 constexpr double kEdgeScale = 1000.0;   // the heaviest boundary gets this edge weight
 constexpr idx_t kMetisSeed = 20111;
-constexpr idx_t kMetisUfactor = 20;   // max part weight <= (1 + 20 / 1000) x mean
+constexpr idx_t kMetisUfactor = 20;  // max part weight <= (1 + 20 / 1000) x mean
 constexpr idx_t kMetisNcuts = 4;
 constexpr int kMetisMinSectorsPerPart = 4;
 constexpr double kMetisMaxSectorShare = 0.5;  // of the mean part work
-constexpr double kMetisAccept = 1.03;  // keep METIS if max/mean <= this (or <= the optimum)
+constexpr double kMetisAccept = 1.03;         // keep METIS if max/mean <= this (or <= the optimum)
 constexpr double kRelativeSlack = 1.0e-12;
 
 void check_parts(int n_sectors, int nparts) {
@@ -113,7 +113,8 @@ class RingPrefix {
     for (int s = 0; s <= g; ++s) {
       int pos = s;
       for (int k = 0; k < levels; ++k)
-        if (nparts & (1 << k)) pos = jump_[static_cast<std::size_t>(k)][static_cast<std::size_t>(pos)];
+        if (nparts & (1 << k))
+          pos = jump_[static_cast<std::size_t>(k)][static_cast<std::size_t>(pos)];
       if (pos >= s + n_) return s;
     }
     return -1;
@@ -335,8 +336,8 @@ bool is_valid(const SectorPartition& p) {
     const Arc a = p.arcs[static_cast<std::size_t>(k)];
     if (a.count < 1 || a.first < 0 || a.first >= n) return false;
     if (k > 0 && a.first <= p.arcs[static_cast<std::size_t>(k - 1)].first) return false;
-    const int next = (k + 1 < np) ? p.arcs[static_cast<std::size_t>(k + 1)].first
-                                  : p.arcs[0].first + n;
+    const int next =
+        (k + 1 < np) ? p.arcs[static_cast<std::size_t>(k + 1)].first : p.arcs[0].first + n;
     if (a.first + a.count != next) return false;
     for (int j = 0; j < a.count; ++j)
       if (p.owner[static_cast<std::size_t>((a.first + j) % n)] != k) return false;
@@ -442,12 +443,14 @@ SectorPartition partition_metis(std::span<const double> sector_work,
   std::vector<idx_t> xadj(un + 1), adjncy(2 * un), vwgt(un), adjwgt(2 * un), part(un, 0);
   std::vector<idx_t> edge(un);
   for (std::size_t s = 0; s < un; ++s) {
-    vwgt[s] = total > 0.0 ? std::max<idx_t>(1, static_cast<idx_t>(std::llround(
-                                                    sector_work[s] * kVertexScale / total)))
-                          : 1;
-    edge[s] = bmax > 0.0 ? std::max<idx_t>(1, static_cast<idx_t>(std::llround(
-                                                  boundary_weight[s] * kEdgeScale / bmax)))
-                         : 1;
+    vwgt[s] = total > 0.0
+                  ? std::max<idx_t>(
+                        1, static_cast<idx_t>(std::llround(sector_work[s] * kVertexScale / total)))
+                  : 1;
+    edge[s] = bmax > 0.0
+                  ? std::max<idx_t>(
+                        1, static_cast<idx_t>(std::llround(boundary_weight[s] * kEdgeScale / bmax)))
+                  : 1;
   }
   for (std::size_t s = 0; s < un; ++s) {
     const std::size_t prev = (s + un - 1) % un, next = (s + 1) % un;
@@ -466,9 +469,9 @@ SectorPartition partition_metis(std::span<const double> sector_work,
   options[METIS_OPTION_NCUTS] = kMetisNcuts;
   options[METIS_OPTION_NUMBERING] = 0;
   idx_t nvtxs = n, ncon = 1, np = nparts, edgecut = 0;
-  const int status = METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(),
-                                         nullptr, adjwgt.data(), &np, nullptr, nullptr, options,
-                                         &edgecut, part.data());
+  const int status =
+      METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr,
+                          adjwgt.data(), &np, nullptr, nullptr, options, &edgecut, part.data());
   if (status != METIS_OK) return fallback("METIS_PartGraphKway returned " + std::to_string(status));
   std::vector<Arc> arcs;
   std::string reason;
@@ -481,8 +484,7 @@ SectorPartition partition_metis(std::span<const double> sector_work,
   const double max_metis = *std::max_element(wm.begin(), wm.end());
   const double max_exact = *std::max_element(we.begin(), we.end());
   const double mean = total / nparts;
-  if (max_metis <= std::max(kMetisAccept * mean, max_exact) * (1.0 + kRelativeSlack))
-    return result;
+  if (max_metis <= std::max(kMetisAccept * mean, max_exact) * (1.0 + kRelativeSlack)) return result;
   return fallback(result.method + " max/mean " + format_ratio(max_metis / mean) + " > " +
                   format_ratio(std::max(kMetisAccept, max_exact / mean)));
 }
@@ -498,9 +500,7 @@ double arc_end_angle(const SectorPartition& p, int part) {
 
 namespace {
 // Distance from p (relative to the ray's origin) to the ray {t u, t >= 0}, |u| = 1.
-double distance_to_ray(Vec2 p, Vec2 u) {
-  return dot(u, p) > 0.0 ? std::abs(cross(u, p)) : norm(p);
-}
+double distance_to_ray(Vec2 p, Vec2 u) { return dot(u, p) > 0.0 ? std::abs(cross(u, p)) : norm(p); }
 }  // namespace
 
 double distance_to_wedge(Vec2 x, Vec2 center, double angle_begin, double angle_end) {

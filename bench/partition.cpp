@@ -1,0 +1,526 @@
+// partition: the angular-sector partition in partition-only mode (no stepping): load balance and
+// halo size of the METIS-weighted sector partition against equal angles, for a settled charge
+// of 30 000 spheres and a 300 000-sphere charge, at 2 .. 64 ranks.
+//
+// Charges (drum centre (0, 0)).
+// (a) The settled 30 000-sphere charge of bench/throughput (bench/settled_drum.hpp), read from
+//     bench/results/cache/settled_drum_30000.csv (x, y, radius, vx, vy, spin; drum radius
+//     2.5 m). If the file is missing the program says how to make it and exits 1.
+// (b) 300 000 spheres in a drum of radius 2.5 sqrt(10) m, built without simulation by tiling
+//     the settled packing: a rectangular patch is cut from the interior of charge (a):
+//     |x| < 0.64 R, from 0.02 R above the drum shell at x = 0.64 R up to 0.05 R below the bed
+//     surface (the 99th percentile of y) - about half the charge. Copies of the patch, placed
+//     side by side with the patch's width and height as periods, cover the big drum; a copy's
+//     particle is kept if it lies inside the drum (|x| + r <= R') and overlaps no particle kept
+//     before it by more than 0.1 mm (the seams between copies cut through the packing: a
+//     kept-first rule on a cell grid removes the seam overlaps; the settled contacts overlap by
+//     micrometres and are kept). The 300 000 lowest of the kept particles (by y, then x) are the
+//     charge: a circular segment at the bottom of the drum with a flat top, the shape of charge
+//     (a) scaled by sqrt(10) (the program prints the two surface heights; the seams' gaps make
+//     the packing slightly looser, so the surface sits slightly higher). Area fraction of the
+//     bed ~0.77 as in (a).
+//
+// Per configuration (charge, work variant, nranks in {2, 4, 8, 16, 32, 64}, sectors per rank
+// spr in {16, 24, 32, 48, 64, 96, 128}; n = nranks spr sectors):
+//  - work per sector: "particles": particles per sector (sector_of, the ownership rule);
+//    "contacts" (charge (a) only): pairs with |x_i - x_j| < r_i + r_j + skin, skin =
+//    0.4 r_min = 2.4 mm (cell grid), each pair counting 1/2 in the sector of each particle;
+//  - boundary weight of the edge between sectors s and s + 1: the particles within the halo
+//    width h = 2 r_max + skin = 22.4 mm of the boundary ray between them (the ray at angle
+//    (s + 1) 2 pi / n; distance to a ray as in sector_partition.hpp);
+//  - partitions: partition_metis (METIS + refinement, exact-ring fallback) and
+//    partition_equal_angle; imbalance = max rank work / mean rank work;
+//  - halo: the ghosts of rank k are the particles owned by another rank whose distance to k's
+//    wedge (distance_to_part) is below h. For each particle only the ranks owning a sector
+//    within the angle asin(h / |x|) (+- one sector) can qualify (all ranks if |x| <= h): O(N)
+//    per partition, no O(N^2). Reported: mean and max ghosts per rank and ghosts / owned
+//    (total ghosts over N).
+// Output: a table (16 and 64 sectors per rank, and the fewest sectors per rank with which the
+// METIS partition reaches 5 %), bench/results/partition.csv (every configuration) and
+// bench/results/partition.png (post/plot_partition.py through std::system; --no-plot skips).
+//
+//   partition [--no-plot] [--results DIR]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/vec2.hpp"
+#include "parallel/sector_partition.hpp"
+
+namespace {
+
+using dem2d::SectorPartition;
+using dem2d::Vec2;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m (bench/settled_drum.hpp)
+constexpr double kSkin = 0.4 * kRadiusMin;
+constexpr double kHalo = 2.0 * kRadiusMax + kSkin;
+constexpr double kRefDrum = 2.5;
+constexpr std::int64_t kBigN = 300000;
+constexpr double kTarget = 1.05;
+const std::vector<int> kRanks{2, 4, 8, 16, 32, 64};
+const std::vector<int> kSectorsPerRank{16, 24, 32, 48, 64, 96, 128};
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+struct Charge {
+  std::string name;
+  double drum_radius = 0.0;
+  std::vector<Vec2> x;
+  std::vector<double> r;
+  std::size_t size() const { return x.size(); }
+};
+
+// Uniform cell grid over the charge's bounding box (counting sort).
+class CellGrid {
+ public:
+  CellGrid(const std::vector<Vec2>& x, double cell) : cell_(cell) {
+    lo_ = {1e300, 1e300};
+    Vec2 hi{-1e300, -1e300};
+    for (Vec2 p : x) {
+      lo_ = {std::min(lo_.x, p.x), std::min(lo_.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    nx_ = static_cast<int>((hi.x - lo_.x) / cell_) + 1;
+    ny_ = static_cast<int>((hi.y - lo_.y) / cell_) + 1;
+    start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+    for (Vec2 p : x) ++start_[index(p) + 1];
+    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    items_.resize(x.size());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      items_[static_cast<std::size_t>(fill[index(x[i])]++)] = static_cast<int>(i);
+  }
+  // Calls f(j) for every item in the 3x3 cells around p.
+  template <class F>
+  void neighbours(Vec2 p, F&& f) const {
+    const int cx = cx_of(p), cy = cy_of(p);
+    for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y)
+      for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x) {
+        const std::size_t c = static_cast<std::size_t>(y) * nx_ + x;
+        for (int k = start_[c]; k < start_[c + 1]; ++k) f(items_[static_cast<std::size_t>(k)]);
+      }
+  }
+
+ private:
+  int cx_of(Vec2 p) const {
+    return std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
+  }
+  int cy_of(Vec2 p) const {
+    return std::clamp(static_cast<int>((p.y - lo_.y) / cell_), 0, ny_ - 1);
+  }
+  std::size_t index(Vec2 p) const { return static_cast<std::size_t>(cy_of(p)) * nx_ + cx_of(p); }
+  double cell_;
+  Vec2 lo_;
+  int nx_ = 1, ny_ = 1;
+  std::vector<int> start_, items_;
+};
+
+bool load_settled(const std::string& path, Charge& c) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::string line;
+  std::getline(in, line);
+  if (line.rfind("# settled_drum", 0) != 0) {
+    std::fprintf(stderr, "partition: %s: first line is not a '# settled_drum' comment\n",
+                 path.c_str());
+    std::exit(1);
+  }
+  std::getline(in, line);  // x,y,radius,vx,vy,spin
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    std::stringstream row(line);
+    std::string f;
+    double v[3];
+    for (double& value : v) {
+      std::getline(row, f, ',');
+      value = std::stod(f);
+    }
+    c.x.push_back({v[0], v[1]});
+    c.r.push_back(v[2]);
+  }
+  return true;
+}
+
+double percentile_y(const Charge& c, double q) {
+  std::vector<double> y;
+  y.reserve(c.size());
+  for (Vec2 p : c.x) y.push_back(p.y);
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(y.size() - 1));
+  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
+  return y[k];
+}
+
+// Charge (b): tiles of a patch of charge (a) (header).
+Charge tile_charge(const Charge& a, std::int64_t n_target) {
+  const double R = a.drum_radius, scale = std::sqrt(static_cast<double>(n_target) / a.size());
+  const double surface = percentile_y(a, 0.99);
+  const double half = 0.64 * R;
+  const double y0 = -std::sqrt(R * R - half * half) + 0.02 * R, y1 = surface - 0.05 * R;
+  const double w = 2.0 * half, h = y1 - y0;
+  std::vector<std::size_t> patch;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a.x[i].x) < half && a.x[i].y >= y0 && a.x[i].y < y1) patch.push_back(i);
+
+  Charge b;
+  b.name = "300k";
+  b.drum_radius = R * scale;
+  const double Rb = b.drum_radius;
+  const double top = surface * scale + 0.1 * Rb;  // generous: trimmed to n_target below
+  const int cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
+  const int rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
+  std::vector<Vec2> cand;
+  std::vector<double> cand_r;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < cols; ++i)
+      for (std::size_t k : patch) {
+        const Vec2 p{a.x[k].x + half - Rb + i * w, a.x[k].y - y0 - Rb + j * h};
+        if (p.y > top || norm(p) + a.r[k] > Rb) continue;
+        cand.push_back(p);
+        cand_r.push_back(a.r[k]);
+      }
+  // Keep-first overlap removal at the seams.
+  const CellGrid grid(cand, 2.0 * kRadiusMax);
+  std::vector<char> kept(cand.size(), 0);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < cand.size(); ++i) {
+    bool clash = false;
+    grid.neighbours(cand[i], [&](int j) {
+      const auto u = static_cast<std::size_t>(j);
+      if (!clash && kept[u] && norm(cand[i] - cand[u]) < cand_r[i] + cand_r[u] - 1.0e-4)
+        clash = true;
+    });
+    if (!clash) {
+      kept[i] = 1;
+      order.push_back(i);
+    }
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
+    return cand[p].y != cand[q].y ? cand[p].y < cand[q].y : cand[p].x < cand[q].x;
+  });
+  if (static_cast<std::int64_t>(order.size()) < n_target) {
+    std::fprintf(stderr, "partition: tiling gave only %zu particles\n", order.size());
+    std::exit(1);
+  }
+  order.resize(static_cast<std::size_t>(n_target));
+  for (std::size_t i : order) {
+    b.x.push_back(cand[i]);
+    b.r.push_back(cand_r[i]);
+  }
+  std::printf(
+      "(b) tiled: patch |x| < %.3f m, y in [%.3f, %.3f) m (%zu particles, of %zu), %d x %d "
+      "copies, %zu candidates, %zu after the seam overlaps; surface y = %.3f m (sqrt(10) x the "
+      "30k surface %.3f m = %.3f m)\n",
+      half, y0, y1, patch.size(), a.size(), cols, rows, cand.size(),
+      static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), b.x.back().y, surface,
+      surface * scale);
+  return b;
+}
+
+// Contacts per particle: pairs with |x_i - x_j| < r_i + r_j + skin.
+std::vector<int> contacts_per_particle(const Charge& c, std::int64_t& pairs) {
+  const CellGrid grid(c.x, 2.0 * kRadiusMax + kSkin);
+  std::vector<int> count(c.size(), 0);
+  pairs = 0;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    grid.neighbours(c.x[i], [&](int j) {
+      const auto u = static_cast<std::size_t>(j);
+      if (u <= i) return;
+      if (norm(c.x[i] - c.x[u]) < c.r[i] + c.r[u] + kSkin) {
+        ++count[i];
+        ++count[u];
+        ++pairs;
+      }
+    });
+  return count;
+}
+
+// Angles and radii about the centre (theta in [0, 2 pi) as in sector_of).
+struct Polar {
+  std::vector<double> theta, rho;
+};
+Polar polar_of(const Charge& c) {
+  Polar p;
+  for (Vec2 x : c.x) {
+    double a = std::atan2(x.y, x.x);
+    if (a < 0.0) a += dem2d::kTwoPi;
+    p.theta.push_back(a);
+    p.rho.push_back(norm(x));
+  }
+  return p;
+}
+
+// Sector index range [lo, hi] (unreduced) covering the angles within the halo of a particle.
+bool halo_window(double theta, double rho, int n, long& lo, long& hi) {
+  if (rho <= kHalo) return false;  // every sector
+  const double delta = std::asin(kHalo / rho), width = dem2d::kTwoPi / n;
+  lo = static_cast<long>(std::floor((theta - delta) / width)) - 1;
+  hi = static_cast<long>(std::floor((theta + delta) / width)) + 1;
+  return hi - lo + 1 < n;
+}
+
+double distance_to_ray(Vec2 p, double angle) {
+  const Vec2 u{std::cos(angle), std::sin(angle)};
+  return dot(u, p) > 0.0 ? std::abs(cross(u, p)) : norm(p);
+}
+
+// boundary[s]: particles within the halo of the ray between sectors s and s + 1.
+std::vector<double> boundary_weights(const Charge& c, const Polar& pol, int n) {
+  std::vector<double> b(static_cast<std::size_t>(n), 0.0);
+  const double width = dem2d::kTwoPi / n;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    long lo = 0, hi = n - 1;
+    if (!halo_window(pol.theta[i], pol.rho[i], n, lo, hi)) {
+      lo = 0;
+      hi = n - 1;
+    }
+    for (long k = lo; k <= hi; ++k) {
+      const long ray = ((k % n) + n) % n;  // boundary ray `ray` lies between ray - 1 and ray
+      if (distance_to_ray(c.x[i], static_cast<double>(ray) * width) < kHalo)
+        b[static_cast<std::size_t>((ray - 1 + n) % n)] += 1.0;
+    }
+  }
+  return b;
+}
+
+struct Halo {
+  std::vector<std::int64_t> owned, ghosts;
+};
+
+Halo halo_of(const Charge& c, const Polar& pol, const std::vector<int>& sector,
+             const SectorPartition& p) {
+  const int n = p.n_sectors, np = p.parts();
+  Halo h;
+  h.owned.assign(static_cast<std::size_t>(np), 0);
+  h.ghosts.assign(static_cast<std::size_t>(np), 0);
+  std::vector<int> cand;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const int own = p.owner[static_cast<std::size_t>(sector[i])];
+    ++h.owned[static_cast<std::size_t>(own)];
+    cand.clear();
+    long lo = 0, hi = 0;
+    if (halo_window(pol.theta[i], pol.rho[i], n, lo, hi)) {
+      for (long k = lo; k <= hi; ++k) {
+        const int q = p.owner[static_cast<std::size_t>(((k % n) + n) % n)];
+        if (q != own && std::find(cand.begin(), cand.end(), q) == cand.end()) cand.push_back(q);
+      }
+    } else {
+      for (int q = 0; q < np; ++q)
+        if (q != own) cand.push_back(q);
+    }
+    for (int q : cand)
+      if (dem2d::distance_to_part(c.x[i], {0.0, 0.0}, p, q) < kHalo)
+        ++h.ghosts[static_cast<std::size_t>(q)];
+  }
+  return h;
+}
+
+struct Row {
+  std::string charge, work, method, detail;
+  std::int64_t n_particles = 0;
+  int nranks = 0, spr = 0;
+  double imbalance = 0.0, ghosts_mean = 0.0, ghost_ratio = 0.0, ms = 0.0;
+  std::int64_t ghosts_max = 0, owned_min = 0, owned_max = 0;
+};
+
+struct Options {
+  bool plot = true;
+  std::string results = DEM2D_SOURCE_DIR "/bench/results";
+};
+
+Options parse(int argc, char** argv) {
+  Options o;
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    if (a == "--no-plot") {
+      o.plot = false;
+    } else if (a == "--results" && k + 1 < argc) {
+      o.results = argv[++k];
+    } else {
+      std::fprintf(stderr, "usage: partition [--no-plot] [--results DIR]\n");
+      std::exit(a == "--help" || a == "-h" ? 0 : 2);
+    }
+  }
+  return o;
+}
+
+const Row* find(const std::vector<Row>& rows, const std::string& charge, const std::string& work,
+                int nranks, int spr, const std::string& method) {
+  for (const Row& r : rows)
+    if (r.charge == charge && r.work == work && r.nranks == nranks && r.spr == spr &&
+        r.method == method)
+      return &r;
+  return nullptr;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options opt = parse(argc, argv);
+  const auto t_start = Clock::now();
+  const std::string cache = opt.results + "/cache/settled_drum_30000.csv";
+  Charge small;
+  small.name = "30k";
+  small.drum_radius = kRefDrum;
+  if (!load_settled(cache, small)) {
+    std::fprintf(stderr,
+                 "partition: %s is missing: make it with\n  build/bench/throughput --particles "
+                 "30000\n(settles the 30 000-sphere charge, ~1 min, and caches it)\n",
+                 cache.c_str());
+    return 1;
+  }
+  std::printf(
+      "== partition: angular sectors, METIS (+refinement) vs equal angles; halo width "
+      "h = 2 r_max + skin = %.1f mm\n",
+      1e3 * kHalo);
+  std::printf("(a) %zu particles from %s\n", small.size(), cache.c_str());
+  const auto t_tile = Clock::now();
+  const Charge big = tile_charge(small, kBigN);
+  std::printf("    (%.2f s)\n", seconds_since(t_tile));
+
+  std::int64_t pairs = 0;
+  const std::vector<int> contacts = contacts_per_particle(small, pairs);
+  std::printf("(a) contact pairs within r_i + r_j + %.1f mm: %lld (%.2f per particle)\n\n",
+              1e3 * kSkin, static_cast<long long>(pairs),
+              2.0 * static_cast<double>(pairs) / static_cast<double>(small.size()));
+
+  struct Case {
+    const Charge* charge;
+    std::string work;
+    std::vector<double> weight;  // per particle
+  };
+  std::vector<Case> cases;
+  cases.push_back({&small, "particles", std::vector<double>(small.size(), 1.0)});
+  {
+    std::vector<double> w(small.size());
+    for (std::size_t i = 0; i < w.size(); ++i) w[i] = 0.5 * contacts[i];
+    cases.push_back({&small, "contacts", w});
+  }
+  cases.push_back({&big, "particles", std::vector<double>(big.size(), 1.0)});
+
+  std::vector<Row> rows;
+  for (const Case& cs : cases) {
+    const Charge& c = *cs.charge;
+    const Polar pol = polar_of(c);
+    for (int spr : kSectorsPerRank) {
+      for (int nranks : kRanks) {
+        const int n = spr * nranks;
+        std::vector<int> sector(c.size());
+        std::vector<double> work(static_cast<std::size_t>(n), 0.0);
+        for (std::size_t i = 0; i < c.size(); ++i) {
+          sector[i] = dem2d::sector_of(c.x[i], {0.0, 0.0}, n);
+          work[static_cast<std::size_t>(sector[i])] += cs.weight[i];
+        }
+        const std::vector<double> bw = boundary_weights(c, pol, n);
+        for (const std::string method : {"metis", "equal-angle"}) {
+          const auto t0 = Clock::now();
+          const SectorPartition p = method == "metis" ? dem2d::partition_metis(work, bw, nranks)
+                                                      : dem2d::partition_equal_angle(n, nranks);
+          const double ms = 1e3 * seconds_since(t0);
+          if (!dem2d::is_valid(p)) {
+            std::fprintf(stderr, "partition: invalid partition (%s)\n", p.method.c_str());
+            return 1;
+          }
+          const Halo h = halo_of(c, pol, sector, p);
+          Row r;
+          r.charge = c.name;
+          r.work = cs.work;
+          r.method = method;
+          r.detail = p.method;
+          r.n_particles = static_cast<std::int64_t>(c.size());
+          r.nranks = nranks;
+          r.spr = spr;
+          r.imbalance = dem2d::imbalance(work, p);
+          r.ms = ms;
+          std::int64_t total_ghosts = 0;
+          for (std::int64_t g : h.ghosts) total_ghosts += g;
+          r.ghosts_mean = static_cast<double>(total_ghosts) / nranks;
+          r.ghosts_max = *std::max_element(h.ghosts.begin(), h.ghosts.end());
+          r.ghost_ratio = static_cast<double>(total_ghosts) / static_cast<double>(c.size());
+          r.owned_min = *std::min_element(h.owned.begin(), h.owned.end());
+          r.owned_max = *std::max_element(h.owned.begin(), h.owned.end());
+          rows.push_back(r);
+        }
+      }
+    }
+  }
+
+  // Table: 16 and 64 sectors per rank, and the fewest sectors per rank reaching 5 %.
+  std::printf("%-5s %-9s %5s | %8s %8s %8s %8s | %5s | %8s %7s %7s %7s | %8s %7s | %s\n", "N",
+              "work", "ranks", "metis16", "equal16", "metis64", "equal64", "spr5%", "ghosts", "max",
+              "g/own", "(64)", "eq ghost", "g/own", "metis16 method");
+  for (const Case& cs : cases) {
+    for (int nranks : kRanks) {
+      const std::string& cn = cs.charge->name;
+      const Row* m16 = find(rows, cn, cs.work, nranks, 16, "metis");
+      const Row* e16 = find(rows, cn, cs.work, nranks, 16, "equal-angle");
+      const Row* m64 = find(rows, cn, cs.work, nranks, 64, "metis");
+      const Row* e64 = find(rows, cn, cs.work, nranks, 64, "equal-angle");
+      std::string spr5 = ">128";
+      for (int spr : kSectorsPerRank) {
+        const Row* r = find(rows, cn, cs.work, nranks, spr, "metis");
+        if (r && r->imbalance <= kTarget) {
+          spr5 = std::to_string(spr);
+          break;
+        }
+      }
+      std::printf(
+          "%-5s %-9s %5d | %8.4f %8.4f %8.4f %8.4f | %5s | %8.1f %7lld %7.4f %7.4f | %8.1f %7.4f "
+          "| %s\n",
+          cn.c_str(), cs.work.c_str(), nranks, m16->imbalance, e16->imbalance, m64->imbalance,
+          e64->imbalance, spr5.c_str(), m16->ghosts_mean, static_cast<long long>(m16->ghosts_max),
+          m16->ghost_ratio, m64->ghost_ratio, e16->ghosts_mean, e16->ghost_ratio,
+          m16->detail.c_str());
+    }
+  }
+  std::printf(
+      "   metisS / equalS: imbalance (max rank work / mean) at S sectors per rank; spr5%%: fewest "
+      "sectors per rank\n"
+      "   (of 16 24 32 48 64 96 128) with METIS imbalance <= %.2f; ghosts, max, g/own: mean and "
+      "max ghosts\n"
+      "   per rank and all ghosts / N for metis16 ((64): metis64); eq ghost, g/own: the same for "
+      "equal16\n",
+      kTarget);
+
+  const std::string csv = opt.results + "/partition.csv";
+  std::filesystem::create_directories(opt.results);
+  std::ofstream out(csv);
+  out << "charge,n_particles,work,nranks,sectors_per_rank,n_sectors,method,method_detail,"
+         "imbalance,owned_min,owned_max,ghosts_mean,ghosts_max,ghost_ratio,partition_ms,"
+         "halo_width\n";
+  char buf[512];
+  for (const Row& r : rows) {
+    std::snprintf(buf, sizeof buf,
+                  "%s,%lld,%s,%d,%d,%d,%s,\"%s\",%.6f,%lld,%lld,%.3f,%lld,%.6f,%.3f,%.4f\n",
+                  r.charge.c_str(), static_cast<long long>(r.n_particles), r.work.c_str(), r.nranks,
+                  r.spr, r.nranks * r.spr, r.method.c_str(), r.detail.c_str(), r.imbalance,
+                  static_cast<long long>(r.owned_min), static_cast<long long>(r.owned_max),
+                  r.ghosts_mean, static_cast<long long>(r.ghosts_max), r.ghost_ratio, r.ms, kHalo);
+    out << buf;
+  }
+  out.close();
+  if (!out) {
+    std::fprintf(stderr, "partition: cannot write %s\n", csv.c_str());
+    return 1;
+  }
+  std::printf("\nwrote %s (%zu rows); %.1f s\n", csv.c_str(), rows.size(), seconds_since(t_start));
+  std::fflush(stdout);
+  if (opt.plot) {
+    const std::string png = opt.results + "/partition.png";
+    const std::string cmd = "/usr/bin/python3 " DEM2D_SOURCE_DIR "/post/plot_partition.py '" + csv +
+                            "' -o '" + png + "'";
+    if (std::system(cmd.c_str()) != 0) std::printf("partition: the plot script failed\n");
+  }
+  return 0;
+}
