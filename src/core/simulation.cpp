@@ -709,9 +709,11 @@ void Simulation::step_iterative() {
 }
 
 void Simulation::check_stability() {
+  // One reduction per step in the common case; the details only when some rank is in trouble.
+  const bool local_ok = std::isfinite(accel_checksum_) && totals_.max_overlap <= kMaxOverlapRatio;
+  if (!domain_->any(!local_ok)) return;
   const double max_overlap = domain_->max(totals_.max_overlap);
-  const bool finite = std::isfinite(domain_->sum(accel_checksum_));
-  if (finite && max_overlap <= kMaxOverlapRatio) return;
+  const bool finite = !domain_->any(!std::isfinite(accel_checksum_));
   std::ostringstream o;
   o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
   if (!finite) {
@@ -724,9 +726,13 @@ void Simulation::check_stability() {
       o << (named++ ? ", particle " : " of particle ") << particles_.id[k];
     }
   } else {
-    o << "overlap " << max_overlap << " of a radius between particle " << totals_.worst_a;
-    if (totals_.worst_b >= 0)
-      o << " and particle " << totals_.worst_b;
+    // The pair at the largest overlap, named alike on every rank (ids are below 2^53).
+    const bool mine = totals_.max_overlap == max_overlap;
+    const auto worst_a = static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals_.worst_a) : -2.0));
+    const auto worst_b = static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals_.worst_b) : -2.0));
+    o << "overlap " << max_overlap << " of a radius between particle " << worst_a;
+    if (worst_b >= 0)
+      o << " and particle " << worst_b;
     else
       o << " and a wall";
   }

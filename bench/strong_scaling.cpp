@@ -1,0 +1,206 @@
+// strong_scaling: the same scenes at 1 and 2 ranks (issue 3).
+//
+//   build/bench/strong_scaling [--ranks 1,2] [--steps S] [--waterfall-time T] [--no-plot]
+//                              [--results DIR]
+//
+// Run without --worker, the program starts itself under `mpirun -np P --worker` for each P and
+// collects one CSV row per (scene, P) from each worker; it then prints the table (speedup and
+// efficiency against P = 1), writes DIR/strong_scaling.csv and plots DIR/strong_scaling.png
+// with post/plot_strong_scaling.py.
+//
+// Scenes:
+//  - drum30k: the 30 000-sphere settled charge of bench/throughput (bench/settled_drum.hpp, read
+//    from DIR/cache/settled_drum_30000.csv: run build/bench/throughput --particles 30000 once),
+//    drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps (default 3000).
+//  - waterfall: inputs/waterfall.in (240 balls), T simulated seconds (default 2).
+// Columns: wall (max over ranks of the timed loop), speedup and efficiency, imbalance (max/mean of
+// the ranks' work = owned particles + listed pairs, at the last rebuild), ghosts per owned
+// particle (halo fraction), the share of the wall time in communication (halo refresh,
+// migration; collectives of the step are not included), migrations, partitions.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "settled_drum.hpp"
+#include "core/simulation.hpp"
+#include "io/deck.hpp"
+#include "parallel/mpi_domain.hpp"
+
+namespace {
+
+using namespace dem2d;
+
+struct Args {
+  std::vector<int> ranks{1, 2};
+  int steps = 3000;
+  double waterfall_time = 2.0;
+  bool plot = true;
+  bool worker = false;
+  std::string results = std::string(DEM2D_SOURCE_DIR) + "/bench/results";
+  std::string rows;  // worker: file to append rows to
+};
+
+struct Row {
+  std::string scene;
+  int ranks = 1;
+  std::int64_t particles = 0, steps = 0;
+  double wall = 0, imbalance = 1, halo_fraction = 0, comm_share = 0;
+  std::int64_t migrated = 0;
+  int partitions = 0;
+};
+
+Row measure(const std::string& name, const Scene& scene, int untimed, std::int64_t steps, MPI_Comm comm) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  DecompositionOptions opt;
+  opt.has_center = scene.drum.present;
+  opt.center = scene.drum.center;
+  MpiDomain domain(comm, opt);
+  Simulation sim(scene, &domain);
+  for (int k = 0; k < untimed; ++k) sim.step();
+  const double comm0 = domain.stats().comm_seconds;
+  MPI_Barrier(comm);
+  const double t0 = MPI_Wtime();
+  for (std::int64_t k = 0; k < steps; ++k) sim.step();
+  const double local = MPI_Wtime() - t0;
+  double wall = 0.0;
+  MPI_Allreduce(&local, &wall, 1, MPI_DOUBLE, MPI_MAX, comm);
+  const double comm_local = domain.stats().comm_seconds - comm0;
+  double comm_max = 0.0;
+  MPI_Allreduce(&comm_local, &comm_max, 1, MPI_DOUBLE, MPI_MAX, comm);
+  Row r;
+  r.scene = name;
+  r.ranks = size;
+  r.particles = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
+  r.steps = steps;
+  r.wall = wall;
+  r.imbalance = domain.stats().imbalance_work;
+  const std::int64_t ghosts = domain.sum(static_cast<std::int64_t>(sim.particles().n_ghost()));
+  r.halo_fraction = static_cast<double>(ghosts) / static_cast<double>(r.particles);
+  r.comm_share = comm_max / wall;
+  r.migrated = domain.sum(domain.stats().migrated);
+  r.partitions = domain.stats().partitions;
+  return r;
+}
+
+std::string csv(const Row& r) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, "%s,%d,%lld,%lld,%.6g,%.6g,%.6g,%.6g,%lld,%d", r.scene.c_str(), r.ranks,
+                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, r.imbalance,
+                r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), r.partitions);
+  return buf;
+}
+
+int worker(const Args& a) {
+  MPI_Init(nullptr, nullptr);
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  std::vector<Row> rows;
+  {
+    const bench::Packing pk = bench::settled_packing(30000, a.results + "/cache", false);
+    if (pk.from_cache) rows.push_back(measure("drum30k", bench::settled_scene(pk, 1e-6), 300, a.steps, MPI_COMM_WORLD));
+  }
+  {
+    Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall.in");
+    rows.push_back(measure("waterfall", s, 0, static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), MPI_COMM_WORLD));
+  }
+  if (rank == 0) {
+    std::ofstream out(a.rows, std::ios::app);
+    for (const Row& r : rows) out << csv(r) << "\n";
+  }
+  MPI_Finalize();
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  for (int k = 1; k < argc; ++k) {
+    const std::string s = argv[k];
+    const auto next = [&]() -> std::string { return k + 1 < argc ? argv[++k] : ""; };
+    if (s == "--worker") a.worker = true;
+    else if (s == "--rows") a.rows = next();
+    else if (s == "--steps") a.steps = std::atoi(next().c_str());
+    else if (s == "--waterfall-time") a.waterfall_time = std::atof(next().c_str());
+    else if (s == "--no-plot") a.plot = false;
+    else if (s == "--results") a.results = next();
+    else if (s == "--ranks") {
+      a.ranks.clear();
+      std::stringstream ls(next());
+      for (std::string t; std::getline(ls, t, ',');) a.ranks.push_back(std::atoi(t.c_str()));
+    } else {
+      std::fprintf(stderr, "usage: strong_scaling [--ranks 1,2] [--steps S] [--waterfall-time T] [--no-plot] [--results DIR]\n");
+      return 2;
+    }
+  }
+  if (a.worker) return worker(a);
+
+  const std::string rows_path = a.results + "/strong_scaling.rows.tmp";
+  std::remove(rows_path.c_str());
+  std::printf("== strong_scaling: drum30k (30 000 spheres, dt 1e-6, %d steps) and waterfall (%.3g s)\n", a.steps,
+              a.waterfall_time);
+  for (int np : a.ranks) {
+    std::ostringstream cmd;
+    cmd << "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np " << np << " --oversubscribe '"
+        << argv[0] << "' --worker --rows '" << rows_path << "' --steps " << a.steps << " --waterfall-time "
+        << a.waterfall_time << " --results '" << a.results << "'";
+    std::printf("$ %s\n", cmd.str().c_str());
+    std::fflush(stdout);
+    if (std::system(cmd.str().c_str()) != 0) {
+      std::fprintf(stderr, "strong_scaling: the run at %d ranks failed\n", np);
+      return 1;
+    }
+  }
+  std::vector<Row> rows;
+  std::ifstream in(rows_path);
+  for (std::string line; std::getline(in, line);) {
+    std::stringstream ls(line);
+    Row r;
+    std::string f;
+    std::getline(ls, r.scene, ',');
+    char c;
+    long long p, st, mg;
+    ls >> r.ranks >> c >> p >> c >> st >> c >> r.wall >> c >> r.imbalance >> c >> r.halo_fraction >> c >>
+        r.comm_share >> c >> mg >> c >> r.partitions;
+    r.particles = p;
+    r.steps = st;
+    r.migrated = mg;
+    rows.push_back(r);
+  }
+  std::remove(rows_path.c_str());
+  const std::string out_csv = a.results + "/strong_scaling.csv";
+  std::ofstream out(out_csv);
+  out << "scene,ranks,particles,steps,wall,speedup,efficiency,imbalance,halo_fraction,comm_share,migrated,partitions,"
+         "particle_steps_per_s\n";
+  std::printf("\n%-10s %5s %9s %7s %9s %8s %6s %9s %6s %6s %9s %12s\n", "scene", "ranks", "particles", "steps",
+              "wall (s)", "speedup", "eff.", "imbalance", "halo", "comm", "migrated", "p-steps/s");
+  for (const Row& r : rows) {
+    double base = r.wall;
+    for (const Row& q : rows)
+      if (q.scene == r.scene && q.ranks == 1) base = q.wall;
+    const double speedup = base / r.wall, eff = speedup / r.ranks;
+    const double rate = static_cast<double>(r.particles) * r.steps / r.wall;
+    std::printf("%-10s %5d %9lld %7lld %9.3f %8.2f %6.2f %9.3f %6.3f %6.3f %9lld %12.3g\n", r.scene.c_str(), r.ranks,
+                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, speedup, eff,
+                r.imbalance, r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), rate);
+    out << r.scene << "," << r.ranks << "," << r.particles << "," << r.steps << "," << r.wall << "," << speedup << ","
+        << eff << "," << r.imbalance << "," << r.halo_fraction << "," << r.comm_share << "," << r.migrated << ","
+        << r.partitions << "," << rate << "\n";
+  }
+  out.close();
+  std::printf("wrote %s\n", out_csv.c_str());
+  if (a.plot) {
+    const std::string cmd = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) + "/post/plot_strong_scaling.py' '" +
+                            out_csv + "' -o '" + a.results + "/strong_scaling.png'";
+    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "strong_scaling: the plot failed\n");
+  }
+  return 0;
+}
