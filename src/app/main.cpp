@@ -143,6 +143,8 @@ int run(const Options& opt) {
   DecompositionOptions decomposition;
   decomposition.has_center = scene.drum.present;
   decomposition.center = scene.drum.center;
+  decomposition.sectors_per_rank = scene.run.sectors_per_rank;
+  decomposition.repartition_threshold = scene.run.repartition_threshold;
   if (opt.check) {
     // Every rank evaluates the whole scene alike; rank 0 prints.
     const Simulation whole(scene);

@@ -56,6 +56,8 @@ struct RunSpec {
   double skin = -1.0;              // m, Verlet skin; < 0: 0.1 of the smallest diameter... set by core
   double dt_safety = 0.2;          // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
   bool allow_unsafe_dt = false;    // run anyway (with a warning) when dt exceeds the safe bound
+  int sectors_per_rank = 32;       // parallel runs: angular sectors per rank (METIS groups them)
+  double repartition_threshold = 1.2;  // parallel runs: max/mean work that triggers a repartition
 };
 
 struct ContactSpec {

@@ -628,6 +628,10 @@ class DeckParser {
     set_if(run.skin, r.number("skin", kNonNegative));
     set_if(run.dt_safety, r.number("dt_safety", kUnitFraction));
     set_if(run.allow_unsafe_dt, r.boolean("allow_unsafe_dt"));
+    if (const auto sectors = r.integer("sectors_per_rank", kAtLeastOne, Need::kOptional, 4096)) {
+      run.sectors_per_rank = static_cast<int>(*sectors);
+    }
+    set_if(run.repartition_threshold, r.number("repartition_threshold", kPositive));
   }
 
   void read_contact(const toml::table& table) {

@@ -188,6 +188,8 @@ DeckTable scene_table(const Scene& scene) {
   if (r.skin >= 0.0) run.number("skin", r.skin);  // absent: the core chooses
   run.number("dt_safety", r.dt_safety);
   run.value("allow_unsafe_dt", r.allow_unsafe_dt);
+  run.integer("sectors_per_rank", r.sectors_per_rank);
+  run.number("repartition_threshold", r.repartition_threshold);
   root.table("run", std::move(run));
 
   DeckTable contact;

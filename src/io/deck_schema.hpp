@@ -52,9 +52,10 @@ constexpr std::string_view choice_name(const std::array<Choice<E>, N>& choices, 
 inline constexpr std::array<std::string_view, 10> kRootKeys = {
     "title", "run",  "contact",  "material", "interaction",
     "drum",  "fill", "particle", "wall",     "output"};
-inline constexpr std::array<std::string_view, 10> kRunKeys = {
+inline constexpr std::array<std::string_view, 12> kRunKeys = {
     "duration", "dt",      "integrator", "tolerance", "max_passes",
-    "seed",     "gravity", "skin",       "dt_safety", "allow_unsafe_dt"};
+    "seed",     "gravity", "skin",       "dt_safety", "allow_unsafe_dt",
+    "sectors_per_rank", "repartition_threshold"};
 inline constexpr std::array<std::string_view, 3> kContactKeys = {"model", "rolling",
                                                                  "rolling_damping"};
 inline constexpr std::array<std::string_view, 11> kMaterialKeys = {"name",
