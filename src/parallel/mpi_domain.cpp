@@ -60,6 +60,7 @@ MpiDomain::MpiDomain(MPI_Comm comm, const DecompositionOptions& options)
 
 // Sum in rank order on every rank: an MPI_Allreduce may add in any order.
 double MpiDomain::sum(double x) const {
+  if (size_ == 1) return x;  // one rank: no MPI call in the step loop
   std::vector<double> all(size_);
   MPI_Allgather(&x, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, comm_);
   double s = 0.0;
@@ -68,18 +69,21 @@ double MpiDomain::sum(double x) const {
 }
 
 double MpiDomain::max(double x) const {
+  if (size_ == 1) return x;
   double r = 0.0;
   MPI_Allreduce(&x, &r, 1, MPI_DOUBLE, MPI_MAX, comm_);
   return r;
 }
 
 std::int64_t MpiDomain::sum(std::int64_t x) const {
+  if (size_ == 1) return x;
   std::int64_t r = 0;
   MPI_Allreduce(&x, &r, 1, MPI_INT64_T, MPI_SUM, comm_);
   return r;
 }
 
 bool MpiDomain::any(bool x) const {
+  if (size_ == 1) return x;
   int in = x ? 1 : 0, out = 0;
   MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_LOR, comm_);
   return out != 0;
@@ -384,6 +388,7 @@ void MpiDomain::exchange_halo(ParticleStore& p) {
 }
 
 void MpiDomain::refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) {
+  if (halo_.peers.empty()) return;  // one rank, or no neighbour within the halo
   CommTimer timer(stats_.comm_seconds);
   fill_ghosts(p, fields);
 }
