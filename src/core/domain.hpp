@@ -46,6 +46,8 @@ class Domain {
   virtual double max(double x) const { return x; }
   virtual std::int64_t sum(std::int64_t x) const { return x; }
   virtual bool any(bool x) const { return x; }
+  // Element-wise maximum over ranks, in place (several decisions in one reduction).
+  virtual void max(std::span<double> /*values*/) const {}
 
   // Every rank holds the same full set of owned particles (the fill is deterministic): keep
   // those in this rank's region, drop the rest. halo_width: how far from its region a rank

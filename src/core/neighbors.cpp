@@ -65,8 +65,11 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
   cell_start_.assign(static_cast<std::size_t>(nx) * ny + 1, 0);
   cell_of_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    const int cx = std::min(nx - 1, static_cast<int>((p.pos[k].x - lo.x) * inv_h));
-    const int cy = std::min(ny - 1, static_cast<int>((p.pos[k].y - lo.y) * inv_h));
+    // A non-finite position (a run blowing up: check_stability reports it) goes to cell 0
+    // rather than to an undefined cell index.
+    const double fx = (p.pos[k].x - lo.x) * inv_h, fy = (p.pos[k].y - lo.y) * inv_h;
+    const int cx = std::isfinite(fx) ? std::min(nx - 1, static_cast<int>(fx)) : 0;
+    const int cy = std::isfinite(fy) ? std::min(ny - 1, static_cast<int>(fy)) : 0;
     cell_of_[k] = cy * nx + cx;
     ++cell_start_[cell_of_[k] + 1];
   }

@@ -452,7 +452,6 @@ void Simulation::rebuild() {
   pos_at_build_.assign(particles_.pos.data(), particles_.pos.data() + particles_.n_owned());
   drum_angle_at_build_ = walls_.drum_angle();
   time_at_build_ = time_;
-  max_disp2_ = 0.0;
 }
 
 bool Simulation::rebuild_needed(double disp) const {
@@ -544,14 +543,24 @@ void Simulation::evaluate_forces(double dt_history, double kick, bool owned_clea
     // Velocity Verlet's closing half kick, fused with the accelerations.
     Vec2* v = p.vel.data();
     double* w = p.omega.data();
-#pragma omp simd reduction(+ : checksum)
+    // Also the two maxima of the next step's displacement bound (check_stability).
+    const Vec2* x = p.pos.data();
+    const Vec2* xb = pos_at_build_.data();
+    double disp2 = 0.0, speed2 = 0.0;
+#pragma omp simd reduction(+ : checksum) reduction(max : disp2, speed2)
     for (std::size_t k = 0; k < n_owned; ++k) {
       a[k] = inv_m[k] * f[k] + gravity_;
       al[k] = inv_i[k] * tq[k];
-      checksum += (a[k].x + a[k].y) + al[k];
+      checksum += (a[k].x + a[k].y) + al[k] + (x[k].x + x[k].y);
       v[k] += kick * a[k];
       w[k] += kick * al[k];
+      const double d2 = norm2(x[k] - xb[k]);
+      const double s2 = norm2(v[k] + kick * a[k]);
+      disp2 = disp2 > d2 ? disp2 : d2;
+      speed2 = speed2 > s2 ? speed2 : s2;
     }
+    next_disp2_ = disp2;
+    next_speed2_ = speed2;
   }
   accel_checksum_ = checksum;
 }
@@ -593,13 +602,11 @@ void Simulation::step_verlet() {
   double* th = p.theta.data();
   double* w = p.omega.data();
   const double* al = p.alpha.data();
-  const Vec2* xb = pos_at_build_.data();
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
-  // Half kick, drift, clear the force accumulators and track the largest displacement since
-  // the last neighbour build, in one pass.
-  double disp2 = max_disp2_;
-#pragma omp simd reduction(max : disp2)
+  // Half kick, drift and clear the force accumulators in one pass. Whether the neighbour
+  // lists still hold after this drift was decided at the end of the previous step
+  // (check_stability), in the same reduction as the stability check.
   for (std::size_t k = 0; k < n; ++k) {
     v[k] += h * a[k];
     w[k] += h * al[k];
@@ -607,13 +614,10 @@ void Simulation::step_verlet() {
     th[k] += dt_ * w[k];
     f[k] = {};
     tq[k] = 0.0;
-    const double d2 = norm2(x[k] - xb[k]);
-    disp2 = disp2 > d2 ? disp2 : d2;
   }
-  max_disp2_ = disp2;
   time_ = static_cast<double>(step_ + 1) * dt_;
   walls_.update(time_);
-  if (rebuild_needed(std::sqrt(max_disp2_)))
+  if (rebuild_next_)
     rebuild();
   else
     domain_->refresh_ghosts(particles_, ghost_fields_);
@@ -710,19 +714,32 @@ void Simulation::step_iterative() {
 
 void Simulation::check_stability() {
   // One reduction per step in the common case; the details only when some rank is in trouble.
+  // The same reduction carries Verlet's rebuild decision for the next step: the next drift
+  // moves a particle by dt |v + a dt/2| (known now), so the displacement bound since the last
+  // build is sqrt(max |x - x_build|^2) + dt sqrt(max |v + a dt/2|^2), and the walls move by at
+  // most their speed times dt more.
   const bool local_ok = std::isfinite(accel_checksum_) && totals_.max_overlap <= kMaxOverlapRatio;
-  if (!domain_->any(!local_ok)) return;
+  double reduce[2] = {local_ok ? 0.0 : 1.0, std::sqrt(next_disp2_) + dt_ * std::sqrt(next_speed2_)};
+  domain_->max(reduce);
+  if (!std::isfinite(reduce[1])) reduce[0] = 1.0;
+  const double wall_move = walls_.rotating_reach() * (std::abs(walls_.drum_angle() - drum_angle_at_build_) +
+                                                      std::abs(walls_.drum_speed()) * dt_) +
+                           walls_.max_translation_speed() * (time_ + dt_ - time_at_build_);
+  rebuild_next_ = 2.0 * reduce[1] + wall_move >= skin_;
+  if (reduce[0] == 0.0) return;
   const double max_overlap = domain_->max(totals_.max_overlap);
   const bool finite = !domain_->any(!std::isfinite(accel_checksum_));
   std::ostringstream o;
   o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
   if (!finite) {
-    o << "non-finite accelerations";
+    o << "non-finite positions or accelerations";
     // interface.md (exit 3) asks for the particle ids: name this rank's first few.
     int named = 0;
     for (std::size_t k = 0; k < particles_.n_owned() && named < 5; ++k) {
       const Vec2 a = particles_.acc[k];
-      if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(particles_.alpha[k])) continue;
+      if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(particles_.alpha[k]) &&
+          std::isfinite(particles_.pos[k].x) && std::isfinite(particles_.pos[k].y))
+        continue;
       o << (named++ ? ", particle " : " of particle ") << particles_.id[k];
     }
   } else {

@@ -160,7 +160,10 @@ class Simulation {
   Array<Vec2> pos_at_build_;
   double drum_angle_at_build_ = 0.0;
   double time_at_build_ = 0.0;
-  double max_disp2_ = 0.0;
+  // Verlet: maxima over owned particles of |x - x_build|^2 and |v + a dt/2|^2 at the end of a
+  // step, and the rebuild decision they give for the next step (check_stability).
+  double next_disp2_ = 0.0, next_speed2_ = 0.0;
+  bool rebuild_next_ = true;
 
   // Iterative integrator: state at the start of the step.
   Array<Vec2> x0_, v0_, a0_, a1_;

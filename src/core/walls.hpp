@@ -83,6 +83,8 @@ class Walls {
   int drum_body() const { return drum_body_; }
   double drum_angle() const { return has_drum() ? bodies_[drum_body_].angle : 0.0; }
   double drum_omega() const { return has_drum() ? bodies_[drum_body_].omega : 0.0; }
+  // The drum's full speed (the ramp never exceeds it), rad/s.
+  double drum_speed() const { return has_drum() ? bodies_[drum_body_].speed : 0.0; }
 
  private:
   std::vector<WallBody> bodies_;

@@ -82,6 +82,11 @@ std::int64_t MpiDomain::sum(std::int64_t x) const {
   return r;
 }
 
+void MpiDomain::max(std::span<double> values) const {
+  if (size_ == 1 || values.empty()) return;
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX, comm_);
+}
+
 bool MpiDomain::any(bool x) const {
   if (size_ == 1) return x;
   int in = x ? 1 : 0, out = 0;
@@ -341,7 +346,8 @@ void MpiDomain::transport(const Plan& plan, std::size_t bytes_per_item,
                           std::vector<std::vector<std::byte>>& recv) {
   const std::size_t np = plan.peers.size();
   recv.resize(np);
-  std::vector<MPI_Request> req;
+  std::vector<MPI_Request>& req = requests_;
+  req.clear();
   req.reserve(2 * np);
   for (std::size_t u = 0; u < np; ++u) {
     recv[u].resize(plan.recv_count[u] * bytes_per_item);
@@ -397,7 +403,10 @@ void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields
   std::size_t bpi = 0;
   for (const FieldBase* f : fields) bpi += f->bytes_per_item();
   const std::size_t np = halo_.peers.size();
-  std::vector<std::vector<std::byte>> send(np), recv;
+  // Buffers kept between calls: the halo refresh runs every step.
+  std::vector<std::vector<std::byte>>& send = send_buffers_;
+  std::vector<std::vector<std::byte>>& recv = recv_buffers_;
+  send.resize(np);
   for (std::size_t u = 0; u < np; ++u) {
     send[u].resize(halo_.send[u].size() * bpi);
     std::byte* out = send[u].data();

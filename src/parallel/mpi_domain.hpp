@@ -76,6 +76,7 @@ class MpiDomain final : public Domain {
   double max(double x) const override;
   std::int64_t sum(std::int64_t x) const override;
   bool any(bool x) const override;
+  void max(std::span<double> values) const override;
 
   void adopt(ParticleStore& p, double halo_width) override;
   void migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) override;
@@ -119,6 +120,8 @@ class MpiDomain final : public Domain {
   double halo_width_ = 0.0;
   std::int64_t total_particles_ = 0;
   Plan halo_;
+  std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
+  std::vector<MPI_Request> requests_;
   bool repartition_due_ = false;
   int rebuilds_since_partition_ = 0;
   DecompositionStats stats_;
