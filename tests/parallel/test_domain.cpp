@@ -322,6 +322,35 @@ TEST(Reproducibility, CentrifugingChargeCrossesSectorsConstantly) {
   expect_same_as_serial(s, 30000, 3000);
 }
 
+TEST(Reproducibility, NoDrumPileFallingIntoABox) {
+  // No drum: sectors about the centre of the particles' initial bounding box. A polydisperse
+  // cloud falls into an open box of three wall segments and piles up across sectors.
+  Scene s;
+  s.title = "no drum: a cloud falling into a box";
+  s.deck_path = "test_domain";
+  s.materials.push_back(steel());
+  s.run.dt_auto = true;
+  for (const auto& [a, b] : {std::pair{Vec2{-0.4, 0.0}, Vec2{0.4, 0.0}}, std::pair{Vec2{-0.4, 0.0}, Vec2{-0.4, 0.6}},
+                             std::pair{Vec2{0.4, 0.0}, Vec2{0.4, 0.6}}}) {
+    WallSpec w;
+    w.from = a;
+    w.to = b;
+    w.material = "steel";
+    s.walls.push_back(w);
+  }
+  FillSpec f;
+  f.material = "steel";
+  f.count = 150;
+  f.radius_min = 0.012;
+  f.radius_max = 0.02;
+  f.region = FillRegion::kBox;
+  f.box_min = {-0.35, 0.05};
+  f.box_max = {0.35, 0.5};
+  f.velocity = {0.5, -0.5};
+  s.fills.push_back(f);
+  expect_same_as_serial(s, 20000, 2000);
+}
+
 TEST(Reproducibility, IterativeIntegratorCentrifuging) {
   Scene s = thesis_drum(120, 10.0, 8);
   s.title = "centrifuging charge, iterative integrator";
