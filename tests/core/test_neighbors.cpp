@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/thesis.hpp"
 #include "core/neighbors.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
@@ -21,18 +22,7 @@ namespace {
 
 using IdPair = std::pair<std::int64_t, std::int64_t>;
 
-MaterialSpec steel() {
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;
-  m.restitution = 0.73;
-  m.sliding_friction = 0.1;
-  m.rolling_friction = 0.05;
-  return m;
-}
+MaterialSpec steel() { return testing_support::thesis_steel(); }
 
 // Brute force: every (particle id, wall element) whose gap is below `skin` (delta > -skin).
 std::vector<IdPair> brute_force_wall_pairs(const ParticleStore& p, const Walls& walls,

@@ -13,24 +13,14 @@
 #include <string>
 #include <vector>
 
+#include "support/thesis.hpp"
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
 
 namespace dem2d {
 namespace {
 
-MaterialSpec thesis_steel(double restitution = 0.73) {
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;  // = E / (2 (1 + nu))
-  m.restitution = restitution;
-  m.sliding_friction = 0.1;
-  m.rolling_friction = 0.05;
-  return m;
-}
+using testing_support::thesis_steel;
 
 Scene base_scene(IntegratorKind integrator = IntegratorKind::kVerlet) {
   Scene s;

@@ -23,6 +23,7 @@
 #include <numbers>
 #include <vector>
 
+#include "support/thesis.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
 
@@ -31,18 +32,7 @@ namespace {
 
 constexpr double kG = 9.81;
 
-MaterialSpec thesis_steel() {
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;  // = E / (2 (1 + nu))
-  m.restitution = 0.73;
-  m.sliding_friction = 0.1;
-  m.rolling_friction = 0.05;
-  return m;
-}
+using testing_support::thesis_steel;
 
 // Thesis drum (radius 2.5 m) with n balls of radius 0.1 m filled from the bottom.
 Scene drum_scene(int n, double speed, int sides, double dt,

@@ -26,6 +26,7 @@
 
 #include "core/simulation.hpp"
 #include "parallel/mpi_domain.hpp"
+#include "support/thesis.hpp"
 
 namespace {
 
@@ -47,18 +48,7 @@ std::int64_t global_sum(std::int64_t x) {
   return r;
 }
 
-MaterialSpec steel() {
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;
-  m.restitution = 0.73;
-  m.sliding_friction = 0.1;
-  m.rolling_friction = 0.05;
-  return m;
-}
+using testing_support::thesis_steel;
 
 // The same hand-placed particles on every rank: the drum centre, both sides of several
 // sector edges, a ring near the wall, and a row through the middle.
@@ -265,23 +255,7 @@ void expect_same_as_serial(const Scene& scene, int steps, int every) {
 }
 
 Scene thesis_drum(int balls, double speed, int sides) {
-  Scene s;
-  s.deck_path = "test_domain";
-  s.materials.push_back(steel());
-  s.run.dt_auto = true;
-  s.drum.present = true;
-  s.drum.radius = 2.5;
-  s.drum.speed = speed;
-  s.drum.ramp_time = 0.1;
-  s.drum.sides = sides;
-  s.drum.material = "steel";
-  FillSpec f;
-  f.material = "steel";
-  f.count = balls;
-  f.radius_min = f.radius_max = 0.1;
-  f.region = FillRegion::kBottom;
-  s.fills.push_back(f);
-  return s;
+  return testing_support::thesis_drum_scene(balls, speed, sides, /*ramp_time=*/0.1);
 }
 
 TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
@@ -290,7 +264,7 @@ TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
   Scene s;
   s.title = "polydisperse, whole drum, centre filled";
   s.deck_path = "test_domain";
-  s.materials.push_back(steel());
+  s.materials.push_back(thesis_steel());
   s.run.dt_auto = true;
   s.run.gravity = {0.0, 0.0};
   s.drum.present = true;
@@ -328,7 +302,7 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
   Scene s;
   s.title = "no drum: a cloud falling into a box";
   s.deck_path = "test_domain";
-  s.materials.push_back(steel());
+  s.materials.push_back(thesis_steel());
   s.run.dt_auto = true;
   for (const auto& [a, b] : {std::pair{Vec2{-0.4, 0.0}, Vec2{0.4, 0.0}}, std::pair{Vec2{-0.4, 0.0}, Vec2{-0.4, 0.6}},
                              std::pair{Vec2{0.4, 0.0}, Vec2{0.4, 0.6}}}) {
