@@ -1,6 +1,6 @@
 // strong_scaling: the same scenes at 1 and 2 ranks (issue 3).
 //
-//   build/bench/strong_scaling [--ranks 1,2] [--steps S] [--waterfall-time T] [--no-plot]
+//   build/bench/strong_scaling [--ranks 1,2] [--steps S] [--repeats R] [--waterfall-time T] [--no-plot]
 //                              [--results DIR]
 //
 // Run without --worker, the program starts itself under `mpirun -np P --worker` for each P and
@@ -11,8 +11,9 @@
 // Scenes:
 //  - drum30k: the 30 000-sphere settled charge of bench/throughput (bench/settled_drum.hpp, read
 //    from DIR/cache/settled_drum_30000.csv: run build/bench/throughput --particles 30000 once),
-//    drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps (default 3000).
-//  - waterfall: inputs/waterfall.in (240 balls), T simulated seconds (default 2).
+//    drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps (default 2000).
+//  - waterfall: inputs/waterfall.in (240 balls), T simulated seconds (default 1).
+// Each timed segment runs R times in a row (--repeats, default 3); the fastest counts.
 // Columns: wall (max over ranks of the timed loop), speedup and efficiency, imbalance (max/mean of
 // the ranks' work = owned particles + listed pairs, at the last rebuild), ghosts per owned
 // particle (halo fraction), the share of the wall time in communication (halo refresh,
@@ -38,8 +39,9 @@ using namespace dem2d;
 
 struct Args {
   std::vector<int> ranks{1, 2};
-  int steps = 3000;
-  double waterfall_time = 2.0;
+  int steps = 2000;
+  int repeats = 3;
+  double waterfall_time = 1.0;
   bool plot = true;
   bool worker = false;
   std::string results = std::string(DEM2D_SOURCE_DIR) + "/bench/results";
@@ -55,26 +57,37 @@ struct Row {
   int partitions = 0;
 };
 
-Row measure(const std::string& name, const Scene& scene, int untimed, std::int64_t steps, MPI_Comm comm) {
+Row measure(const std::string& name, const Scene& scene, int untimed, std::int64_t steps, int repeats,
+            MPI_Comm comm) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
   DecompositionOptions opt;
   opt.has_center = scene.drum.present;
   opt.center = scene.drum.center;
+  opt.sectors_per_rank = scene.run.sectors_per_rank;
+  opt.repartition_threshold = scene.run.repartition_threshold;
   MpiDomain domain(comm, opt);
   Simulation sim(scene, &domain);
   for (int k = 0; k < untimed; ++k) sim.step();
-  const double comm0 = domain.stats().comm_seconds;
-  MPI_Barrier(comm);
-  const double t0 = MPI_Wtime();
-  for (std::int64_t k = 0; k < steps; ++k) sim.step();
-  const double local = MPI_Wtime() - t0;
-  double wall = 0.0;
-  MPI_Allreduce(&local, &wall, 1, MPI_DOUBLE, MPI_MAX, comm);
-  const double comm_local = domain.stats().comm_seconds - comm0;
-  double comm_max = 0.0;
-  MPI_Allreduce(&comm_local, &comm_max, 1, MPI_DOUBLE, MPI_MAX, comm);
+  // The machine is shared: the timed segment is repeated (the run continues) and the fastest
+  // of the repeats is kept, for the communication share too.
+  double wall = 1e300, comm_max = 0.0;
+  for (int rep = 0; rep < repeats; ++rep) {
+    const double comm0 = domain.stats().comm_seconds;
+    MPI_Barrier(comm);
+    const double t0 = MPI_Wtime();
+    for (std::int64_t k = 0; k < steps; ++k) sim.step();
+    const double local = MPI_Wtime() - t0;
+    double seg = 0.0, comm_seg = 0.0;
+    MPI_Allreduce(&local, &seg, 1, MPI_DOUBLE, MPI_MAX, comm);
+    const double comm_local = domain.stats().comm_seconds - comm0;
+    MPI_Allreduce(&comm_local, &comm_seg, 1, MPI_DOUBLE, MPI_MAX, comm);
+    if (seg < wall) {
+      wall = seg;
+      comm_max = comm_seg;
+    }
+  }
   Row r;
   r.scene = name;
   r.ranks = size;
@@ -105,11 +118,12 @@ int worker(const Args& a) {
   std::vector<Row> rows;
   {
     const bench::Packing pk = bench::settled_packing(30000, a.results + "/cache", false);
-    if (pk.from_cache) rows.push_back(measure("drum30k", bench::settled_scene(pk, 1e-6), 300, a.steps, MPI_COMM_WORLD));
+    if (pk.from_cache) rows.push_back(measure("drum30k", bench::settled_scene(pk, 1e-6), 300, a.steps, a.repeats, MPI_COMM_WORLD));
   }
   {
     Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall.in");
-    rows.push_back(measure("waterfall", s, 0, static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), MPI_COMM_WORLD));
+    rows.push_back(measure("waterfall", s, 0, static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), a.repeats,
+                           MPI_COMM_WORLD));
   }
   if (rank == 0) {
     std::ofstream out(a.rows, std::ios::app);
@@ -129,6 +143,7 @@ int main(int argc, char** argv) {
     if (s == "--worker") a.worker = true;
     else if (s == "--rows") a.rows = next();
     else if (s == "--steps") a.steps = std::atoi(next().c_str());
+    else if (s == "--repeats") a.repeats = std::max(1, std::atoi(next().c_str()));
     else if (s == "--waterfall-time") a.waterfall_time = std::atof(next().c_str());
     else if (s == "--no-plot") a.plot = false;
     else if (s == "--results") a.results = next();
@@ -137,7 +152,7 @@ int main(int argc, char** argv) {
       std::stringstream ls(next());
       for (std::string t; std::getline(ls, t, ',');) a.ranks.push_back(std::atoi(t.c_str()));
     } else {
-      std::fprintf(stderr, "usage: strong_scaling [--ranks 1,2] [--steps S] [--waterfall-time T] [--no-plot] [--results DIR]\n");
+      std::fprintf(stderr, "usage: strong_scaling [--ranks 1,2] [--steps S] [--repeats R] [--waterfall-time T] [--no-plot] [--results DIR]\n");
       return 2;
     }
   }
@@ -150,7 +165,7 @@ int main(int argc, char** argv) {
   for (int np : a.ranks) {
     std::ostringstream cmd;
     cmd << "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np " << np << " --oversubscribe '"
-        << argv[0] << "' --worker --rows '" << rows_path << "' --steps " << a.steps << " --waterfall-time "
+        << argv[0] << "' --worker --rows '" << rows_path << "' --steps " << a.steps << " --repeats " << a.repeats << " --waterfall-time "
         << a.waterfall_time << " --results '" << a.results << "'";
     std::printf("$ %s\n", cmd.str().c_str());
     std::fflush(stdout);
