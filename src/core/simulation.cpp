@@ -165,6 +165,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
       tq[j] += b.t_j[c];
       trial[k] = ContactHistory{b.xi_new[c], b.mr_new[c]};
     }
+    // Counted apart from the scatter: this loop vectorises, the scatter cannot.
     for (std::size_t c = 0; c < n; ++c) contacts += b.counted[c] > 0.5 ? 1 : 0;
     // The first pair at the largest overlap so far names the culprits of a blow-up.
     const double chunk_max = stdx::hmax(chunk_overlap);
@@ -177,7 +178,7 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
         }
     }
     max_ratio = std::max(max_ratio, chunk_max);
-}
+  }
   double dissipated_sum = stdx::reduce(dissipated), elastic_sum = stdx::reduce(elastic);
 
   // Walls: R* = r_i, m* = m_i; the wall's velocity at the contact point enters v_rel. The
@@ -194,6 +195,8 @@ void force_kernel(Simulation& sim, double dt, EvaluationTotals& tot) {
   for (std::size_t k = 0; k < wl.size(); ++k) {
     const std::int32_t i = wl.particle[k];
     wl.trial[k] = ContactHistory{};  // overwritten by the scatter for the contacts
+    // Most candidates do not touch: the cheap test skips the square root and division of the
+    // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).
     if (!walls.touches(wl.element[k], x[i], r[i])) continue;
     const WallGeometry g = walls.geometry(wl.element[k], x[i], r[i]);
     if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit

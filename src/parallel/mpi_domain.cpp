@@ -24,27 +24,21 @@ class CommTimer {
   double start_;
 };
 
-std::size_t record_bytes(const ParticleStore& p) { return p.bytes_per_particle(); }
-
-void pack_particle(const ParticleStore& p, std::size_t i, std::byte* out) {
-  for (const FieldBase* f : p.fields()) {
+// Item i of each field, one after the other (migration: every field; halo: some).
+std::byte* pack_fields(std::span<FieldBase* const> fields, std::size_t i, std::byte* out) {
+  for (const FieldBase* f : fields) {
     f->pack(i, out);
     out += f->bytes_per_item();
   }
+  return out;
 }
 
-void unpack_particle(ParticleStore& p, std::size_t i, const std::byte* in) {
-  for (FieldBase* f : p.fields()) {
+const std::byte* unpack_fields(std::span<FieldBase* const> fields, std::size_t i, const std::byte* in) {
+  for (FieldBase* f : fields) {
     f->unpack(i, in);
     in += f->bytes_per_item();
   }
-}
-
-// Distance from x to the ray from c along angle a.
-double distance_to_ray(Vec2 x, Vec2 c, double a) {
-  const Vec2 u{std::cos(a), std::sin(a)};
-  const Vec2 d = x - c;
-  return dot(u, d) > 0.0 ? std::abs(cross(u, d)) : norm(d);
+  return in;
 }
 
 }  // namespace
@@ -127,14 +121,16 @@ void MpiDomain::rebuild_wedges() {
 void MpiDomain::repartition(const ParticleStore& p) {
   const int n = options_.sectors_per_rank * size_;
   const double step = kTwoPi / n;
+  std::vector<Vec2> ray(static_cast<std::size_t>(n) + 1);  // unit direction of boundary ray s
+  for (int s = 0; s <= n; ++s) ray[static_cast<std::size_t>(s)] = {std::cos(s * step), std::sin(s * step)};
   std::vector<double> weights(2 * static_cast<std::size_t>(n), 0.0);  // work, then boundaries
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const int s = sector_of(p.pos[k], options_.center, n);
     weights[static_cast<std::size_t>(s)] += 1.0;
     // Boundary ray s lies between sectors s - 1 and s: edge s - 1; ray s + 1: edge s.
-    if (distance_to_ray(p.pos[k], options_.center, s * step) < halo_width_)
+    if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s)]) < halo_width_)
       weights[static_cast<std::size_t>(n + (s + n - 1) % n)] += 1.0;
-    if (distance_to_ray(p.pos[k], options_.center, (s + 1) * step) < halo_width_)
+    if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s) + 1]) < halo_width_)
       weights[static_cast<std::size_t>(n + s)] += 1.0;
   }
   std::vector<double> total(weights.size());
@@ -254,7 +250,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
   agree(error.str());
 
   // Particles and their histories, per destination rank.
-  const std::size_t bpp = record_bytes(p);
+  const std::size_t bpp = p.bytes_per_particle();
   std::vector<std::vector<std::byte>> send_particles(static_cast<std::size_t>(size_));
   std::vector<std::vector<HistoryRecord>> send_records(static_cast<std::size_t>(size_));
   std::unordered_map<std::int64_t, int> dest_of_leaving;
@@ -263,7 +259,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
     auto& buf = send_particles[static_cast<std::size_t>(dest[k])];
     const std::size_t at = buf.size();
     buf.resize(at + bpp);
-    pack_particle(p, k, buf.data() + at);
+    pack_fields(p.fields(), k, buf.data() + at);
     dest_of_leaving.emplace(p.id[k], dest[k]);
   }
   for (const HistoryRecord& r : histories) {
@@ -316,7 +312,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
   p.remove_if(leaving);
   const std::size_t n_new = arrived.size() / bpp;
   const std::size_t first = p.add_owned(n_new);
-  for (std::size_t k = 0; k < n_new; ++k) unpack_particle(p, first + k, arrived.data() + k * bpp);
+  for (std::size_t k = 0; k < n_new; ++k) unpack_fields(p.fields(), first + k, arrived.data() + k * bpp);
   if (!std::is_sorted(p.id.data(), p.id.data() + p.n_owned())) {
     std::vector<std::size_t> order(p.n_owned());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
@@ -385,11 +381,10 @@ void MpiDomain::exchange_halo(ParticleStore& p) {
     halo_.send.push_back(std::move(to[u]));
     halo_.recv_count.push_back(static_cast<std::size_t>(recv_n[u]));
   }
-  std::vector<FieldBase*> all(p.fields().begin(), p.fields().end());
   std::size_t n_ghost = 0;
   for (std::size_t c : halo_.recv_count) n_ghost += c;
   p.add_ghosts(n_ghost);
-  fill_ghosts(p, all);
+  fill_ghosts(p, p.fields());
   stats_.ghosts = static_cast<std::int64_t>(n_ghost);
 }
 
@@ -410,21 +405,13 @@ void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields
   for (std::size_t u = 0; u < np; ++u) {
     send[u].resize(halo_.send[u].size() * bpi);
     std::byte* out = send[u].data();
-    for (const std::int32_t k : halo_.send[u])
-      for (const FieldBase* f : fields) {
-        f->pack(static_cast<std::size_t>(k), out);
-        out += f->bytes_per_item();
-      }
+    for (const std::int32_t k : halo_.send[u]) out = pack_fields(fields, static_cast<std::size_t>(k), out);
   }
   transport(halo_, bpi, send, recv);
   std::size_t slot = p.n_owned();
   for (std::size_t u = 0; u < np; ++u) {
     const std::byte* in = recv[u].data();
-    for (std::size_t c = 0; c < halo_.recv_count[u]; ++c, ++slot)
-      for (FieldBase* f : fields) {
-        f->unpack(slot, in);
-        in += f->bytes_per_item();
-      }
+    for (std::size_t c = 0; c < halo_.recv_count[u]; ++c, ++slot) in = unpack_fields(fields, slot, in);
   }
 }
 

@@ -498,10 +498,10 @@ double arc_end_angle(const SectorPartition& p, int part) {
   return (a.first + a.count) * (kTwoPi / p.n_sectors);
 }
 
-namespace {
-// Distance from p (relative to the ray's origin) to the ray {t u, t >= 0}, |u| = 1.
-double distance_to_ray(Vec2 p, Vec2 u) { return dot(u, p) > 0.0 ? std::abs(cross(u, p)) : norm(p); }
-}  // namespace
+double distance_to_ray(Vec2 x, Vec2 center, Vec2 u) {
+  const Vec2 p = x - center;
+  return dot(u, p) > 0.0 ? std::abs(cross(u, p)) : norm(p);
+}
 
 double distance_to_wedge(Vec2 x, Vec2 center, double angle_begin, double angle_end) {
   double span = angle_end - angle_begin;
@@ -515,7 +515,7 @@ double distance_to_wedge(Vec2 x, Vec2 center, double angle_begin, double angle_e
   if (rel <= span) return 0.0;
   const Vec2 ub{std::cos(angle_begin), std::sin(angle_begin)};
   const Vec2 ue{std::cos(angle_end), std::sin(angle_end)};
-  return std::min(distance_to_ray(p, ub), distance_to_ray(p, ue));
+  return std::min(distance_to_ray(x, center, ub), distance_to_ray(x, center, ue));
 }
 
 double distance_to_part(Vec2 x, Vec2 center, const SectorPartition& p, int part) {

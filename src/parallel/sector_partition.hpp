@@ -134,6 +134,9 @@ bool is_valid(const SectorPartition& p);
 double arc_begin_angle(const SectorPartition& p, int part);
 double arc_end_angle(const SectorPartition& p, int part);
 
+// Distance from x to the ray {center + t u, t >= 0} (u a unit vector).
+double distance_to_ray(Vec2 x, Vec2 center, Vec2 u);
+
 // Euclidean distance from x to the closed wedge {angle from angle_begin ccw to angle_end}.
 double distance_to_wedge(Vec2 x, Vec2 center, double angle_begin, double angle_end);
 

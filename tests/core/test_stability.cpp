@@ -43,19 +43,8 @@ void add_ball(Scene& s, Vec2 x, Vec2 v, double r, double spin = 0.0) {
 
 // The thesis drum (radius 2.5 m, regular polygon) with n balls of radius 0.1 m from the bottom.
 Scene drum_scene(int n, double speed, int sides) {
-  Scene s = base_scene();
-  s.drum.present = true;
-  s.drum.radius = 2.5;
-  s.drum.speed = speed;
-  s.drum.ramp_time = 0.5;
-  s.drum.sides = sides;
-  s.drum.material = "steel";
-  FillSpec f;
-  f.material = "steel";
-  f.count = n;
-  f.radius_min = f.radius_max = 0.1;
-  f.region = FillRegion::kBottom;
-  s.fills.push_back(f);
+  Scene s = testing_support::thesis_drum_scene(n, speed, sides);
+  s.deck_path = "test_stability";
   return s;
 }
 

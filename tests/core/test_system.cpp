@@ -37,23 +37,10 @@ using testing_support::thesis_steel;
 // Thesis drum (radius 2.5 m) with n balls of radius 0.1 m filled from the bottom.
 Scene drum_scene(int n, double speed, int sides, double dt,
                  IntegratorKind integrator = IntegratorKind::kVerlet) {
-  Scene s;
+  Scene s = testing_support::thesis_drum_scene(n, speed, sides, speed != 0.0 ? 0.5 : 0.0);
   s.deck_path = "test_system";
-  s.materials.push_back(thesis_steel());
   s.contact.model = ContactModelKind::kHertzMindlin;
   s.contact.rolling = RollingModelKind::kEpsd;
-  s.drum.present = true;
-  s.drum.radius = 2.5;
-  s.drum.speed = speed;
-  s.drum.ramp_time = speed != 0.0 ? 0.5 : 0.0;
-  s.drum.sides = sides;
-  s.drum.material = "steel";
-  FillSpec f;
-  f.material = "steel";
-  f.count = n;
-  f.radius_min = f.radius_max = 0.1;
-  f.region = FillRegion::kBottom;
-  s.fills.push_back(f);
   s.run.dt_auto = false;
   s.run.dt = dt;
   s.run.integrator = integrator;
