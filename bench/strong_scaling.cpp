@@ -16,8 +16,10 @@
 // Each timed segment runs R times in a row (--repeats, default 3); the fastest counts.
 // Columns: wall (max over ranks of the timed loop), speedup and efficiency, imbalance (max/mean of
 // the ranks' work = owned particles + listed pairs, at the last rebuild), ghosts per owned
-// particle (halo fraction), the share of the wall time in communication (halo refresh,
-// migration; collectives of the step are not included), migrations, partitions.
+// particle (halo fraction), the share of the wall time in communication (halo refresh, the
+// end-of-step round that carries the step's reduction, migration), migrations, partitions, and
+// the ceiling: the speedup if communication and waiting cost nothing (T1 over the largest
+// per-rank time outside communication), which bounds what a faster transport could give.
 #include <mpi.h>
 
 #include <algorithm>
@@ -52,7 +54,7 @@ struct Row {
   std::string scene;
   int ranks = 1;
   std::int64_t particles = 0, steps = 0;
-  double wall = 0, imbalance = 1, halo_fraction = 0, comm_share = 0;
+  double wall = 0, compute = 0, imbalance = 1, halo_fraction = 0, comm_share = 0;
   std::int64_t migrated = 0;
   int partitions = 0;
 };
@@ -72,7 +74,7 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
   for (int k = 0; k < untimed; ++k) sim.step();
   // The machine is shared: the timed segment is repeated (the run continues) and the fastest
   // of the repeats is kept, for the communication share too.
-  double wall = 1e300, comm_max = 0.0;
+  double wall = 1e300, comm_max = 0.0, compute_max = 0.0;
   for (int rep = 0; rep < repeats; ++rep) {
     const double comm0 = domain.stats().comm_seconds;
     MPI_Barrier(comm);
@@ -83,9 +85,13 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
     MPI_Allreduce(&local, &seg, 1, MPI_DOUBLE, MPI_MAX, comm);
     const double comm_local = domain.stats().comm_seconds - comm0;
     MPI_Allreduce(&comm_local, &comm_seg, 1, MPI_DOUBLE, MPI_MAX, comm);
+    const double compute_local = local - comm_local;
+    double compute_seg = 0.0;
+    MPI_Allreduce(&compute_local, &compute_seg, 1, MPI_DOUBLE, MPI_MAX, comm);
     if (seg < wall) {
       wall = seg;
       comm_max = comm_seg;
+      compute_max = compute_seg;
     }
   }
   Row r;
@@ -94,6 +100,7 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
   r.particles = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
   r.steps = steps;
   r.wall = wall;
+  r.compute = compute_max;
   r.imbalance = domain.stats().imbalance_work;
   const std::int64_t ghosts = domain.sum(static_cast<std::int64_t>(sim.particles().n_ghost()));
   r.halo_fraction = static_cast<double>(ghosts) / static_cast<double>(r.particles);
@@ -105,8 +112,8 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
 
 std::string csv(const Row& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s,%d,%lld,%lld,%.6g,%.6g,%.6g,%.6g,%lld,%d", r.scene.c_str(), r.ranks,
-                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, r.imbalance,
+  std::snprintf(buf, sizeof buf, "%s,%d,%lld,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%lld,%d", r.scene.c_str(), r.ranks,
+                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, r.compute, r.imbalance,
                 r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), r.partitions);
   return buf;
 }
@@ -183,7 +190,7 @@ int main(int argc, char** argv) {
     std::getline(ls, r.scene, ',');
     char c;
     long long p, st, mg;
-    ls >> r.ranks >> c >> p >> c >> st >> c >> r.wall >> c >> r.imbalance >> c >> r.halo_fraction >> c >>
+    ls >> r.ranks >> c >> p >> c >> st >> c >> r.wall >> c >> r.compute >> c >> r.imbalance >> c >> r.halo_fraction >> c >>
         r.comm_share >> c >> mg >> c >> r.partitions;
     r.particles = p;
     r.steps = st;
@@ -194,21 +201,24 @@ int main(int argc, char** argv) {
   const std::string out_csv = a.results + "/strong_scaling.csv";
   std::ofstream out(out_csv);
   out << "scene,ranks,particles,steps,wall,speedup,efficiency,imbalance,halo_fraction,comm_share,migrated,partitions,"
-         "particle_steps_per_s\n";
-  std::printf("\n%-10s %5s %9s %7s %9s %8s %6s %9s %6s %6s %9s %12s\n", "scene", "ranks", "particles", "steps",
-              "wall (s)", "speedup", "eff.", "imbalance", "halo", "comm", "migrated", "p-steps/s");
+         "particle_steps_per_s,us_per_step,ceiling\n";
+  std::printf("\n%-10s %5s %9s %7s %9s %8s %6s %9s %6s %6s %9s %12s %8s %8s\n", "scene", "ranks", "particles", "steps",
+              "wall (s)", "speedup", "eff.", "imbalance", "halo", "comm", "migrated", "p-steps/s", "us/step", "ceiling");
   for (const Row& r : rows) {
     double base = r.wall;
     for (const Row& q : rows)
       if (q.scene == r.scene && q.ranks == 1) base = q.wall;
     const double speedup = base / r.wall, eff = speedup / r.ranks;
     const double rate = static_cast<double>(r.particles) * r.steps / r.wall;
-    std::printf("%-10s %5d %9lld %7lld %9.3f %8.2f %6.2f %9.3f %6.3f %6.3f %9lld %12.3g\n", r.scene.c_str(), r.ranks,
-                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, speedup, eff,
-                r.imbalance, r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), rate);
+    const double us_per_step = 1e6 * r.wall / static_cast<double>(r.steps);
+    const double ceiling = r.compute > 0.0 ? base / r.compute : 0.0;
+    std::printf("%-10s %5d %9lld %7lld %9.3f %8.2f %6.2f %9.3f %6.3f %6.3f %9lld %12.3g %8.2f %8.2f\n", r.scene.c_str(),
+                r.ranks, static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, speedup, eff,
+                r.imbalance, r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), rate, us_per_step,
+                ceiling);
     out << r.scene << "," << r.ranks << "," << r.particles << "," << r.steps << "," << r.wall << "," << speedup << ","
         << eff << "," << r.imbalance << "," << r.halo_fraction << "," << r.comm_share << "," << r.migrated << ","
-        << r.partitions << "," << rate << "\n";
+        << r.partitions << "," << rate << "," << us_per_step << "," << ceiling << "\n";
   }
   out.close();
   std::printf("wrote %s\n", out_csv.c_str());

@@ -28,7 +28,10 @@ def main():
         rs.sort(key=lambda r: int(r["ranks"]))
         p = [int(r["ranks"]) for r in rs]
         top = max(top, max(p))
-        ax1.plot(p, [float(r["speedup"]) for r in rs], "o-", label=scene)
+        line, = ax1.plot(p, [float(r["speedup"]) for r in rs], "o-", label=scene)
+        if "ceiling" in rs[0]:
+            ax1.plot(p, [float(r["ceiling"]) for r in rs], "s--", color=line.get_color(), alpha=0.6,
+                     label=f"{scene}: ceiling (free communication)")
         ax2.plot(p, [100 * float(r["comm_share"]) for r in rs], "o-", label=scene)
     ax1.plot([1, top], [1, top], "k:", label="ideal")
     ax1.axhline(1.9, color="grey", lw=0.8, ls="--", label="target 1.9 (drum30k, 2 ranks)")

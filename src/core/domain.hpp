@@ -12,7 +12,11 @@
 //     registered field and the contact histories that involve them) -> exchange_halo() (a new
 //     ghost set) -> the core builds the neighbour lists over owned + ghosts;
 //   every other force evaluation: refresh_ghosts() (positions, velocities, spins of the same
-//     ghosts, in the same slots).
+//     ghosts, in the same slots);
+//   the end of a velocity-Verlet step: exchange_step() in one round both decides the next step
+//     (a maximum over ranks: stability, rebuild) and hands every ghost the state its owner
+//     will drift it to (the core computes it ahead for halo_sources()), so the next step needs
+//     no refresh. One synchronisation per step instead of two.
 #pragma once
 
 #include <cstdint>
@@ -64,6 +68,14 @@ class Domain {
   virtual void exchange_halo(ParticleStore&) {}
   // Refresh the given fields of the same ghosts from their owners.
   virtual void refresh_ghosts(ParticleStore&, std::span<FieldBase* const> /*fields*/) {}
+  // Owned particles that other ranks hold as ghosts since the last exchange_halo(): local
+  // indices, ascending, without repeats. Empty on one rank.
+  virtual std::span<const std::int32_t> halo_sources() const { return {}; }
+  // One round: `values` becomes its element-wise maximum over ranks (a NaN anywhere gives NaN,
+  // so the result is the same on every rank), and each ghost's `recv_fields` receive its
+  // owner's `send_fields` (same types, in the same order; only halo_sources() are read).
+  virtual void exchange_step(ParticleStore& /*p*/, std::span<FieldBase* const> /*send_fields*/,
+                             std::span<FieldBase* const> /*recv_fields*/, std::span<double> /*values*/) {}
   // Called after each neighbour rebuild with this rank's work (owned particles + listed pairs);
   // a parallel domain may repartition at its next migrate() when the imbalance grew.
   virtual void report_work(double /*work*/) {}

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,10 @@ class FieldBase {
   virtual void pack(std::size_t i, std::byte* out) const = 0;
   virtual void unpack(std::size_t i, const std::byte* in) = 0;
   virtual void permute(const std::vector<std::size_t>& order) = 0;  // new[k] = old[order[k]]
+  // Items idx[0], idx[1], ... one after the other (the halo: one virtual call per field).
+  virtual std::byte* pack_items(std::span<const std::int32_t> idx, std::byte* out) const = 0;
+  // Items first, first + 1, ..., first + n - 1 from consecutive bytes.
+  virtual const std::byte* unpack_items(std::size_t first, std::size_t n, const std::byte* in) = 0;
 
  private:
   std::string name_;
@@ -51,6 +56,17 @@ class Field final : public FieldBase {
   void copy_item(std::size_t dst, std::size_t src) override { data_[dst] = data_[src]; }
   void pack(std::size_t i, std::byte* out) const override { std::memcpy(out, &data_[i], sizeof(T)); }
   void unpack(std::size_t i, const std::byte* in) override { std::memcpy(&data_[i], in, sizeof(T)); }
+  std::byte* pack_items(std::span<const std::int32_t> idx, std::byte* out) const override {
+    for (const std::int32_t i : idx) {
+      std::memcpy(out, &data_[static_cast<std::size_t>(i)], sizeof(T));
+      out += sizeof(T);
+    }
+    return out;
+  }
+  const std::byte* unpack_items(std::size_t first, std::size_t n, const std::byte* in) override {
+    if (n) std::memcpy(static_cast<void*>(&data_[first]), in, n * sizeof(T));
+    return in + n * sizeof(T);
+  }
   void permute(const std::vector<std::size_t>& order) override {
     Array<T> out(order.size());
     for (std::size_t k = 0; k < order.size(); ++k) out[k] = data_[order[k]];

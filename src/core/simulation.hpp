@@ -154,6 +154,13 @@ class Simulation {
   double skin_ = 0.0;
   double halo_width_ = 0.0;
   std::vector<FieldBase*> ghost_fields_;  // refreshed on ghosts every force evaluation
+  // Velocity Verlet in parallel: the state the halo sources will drift to in the next step
+  // (their next_* entries only), sent to the ghosts at the end of a step (exchange_step).
+  std::vector<FieldBase*> next_registry_;
+  Field<Vec2> next_pos_{"next_position", next_registry_};
+  Field<Vec2> next_vel_{"next_velocity", next_registry_};
+  Field<double> next_omega_{"next_spin", next_registry_};
+  bool ghosts_ahead_ = false;  // the ghosts already hold the coming step's drifted state
   Vec2 gravity_{};
 
   // Rebuild bookkeeping: positions and wall pose at the last build.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <unordered_map>
@@ -24,7 +25,7 @@ class CommTimer {
   double start_;
 };
 
-// Item i of each field, one after the other (migration: every field; halo: some).
+// Item i of each field, one after the other (migration: every field of a particle together).
 std::byte* pack_fields(std::span<FieldBase* const> fields, std::size_t i, std::byte* out) {
   for (const FieldBase* f : fields) {
     f->pack(i, out);
@@ -337,7 +338,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
   }
 }
 
-void MpiDomain::transport(const Plan& plan, std::size_t bytes_per_item,
+void MpiDomain::transport(const Plan& plan, std::size_t header_bytes, std::size_t bytes_per_item,
                           const std::vector<std::vector<std::byte>>& send,
                           std::vector<std::vector<std::byte>>& recv) {
   const std::size_t np = plan.peers.size();
@@ -346,7 +347,7 @@ void MpiDomain::transport(const Plan& plan, std::size_t bytes_per_item,
   req.clear();
   req.reserve(2 * np);
   for (std::size_t u = 0; u < np; ++u) {
-    recv[u].resize(plan.recv_count[u] * bytes_per_item);
+    recv[u].resize(header_bytes + plan.recv_count[u] * bytes_per_item);
     if (recv[u].empty()) continue;
     req.emplace_back();
     MPI_Irecv(recv[u].data(), static_cast<int>(recv[u].size()), MPI_BYTE, plan.peers[u], kTagHalo, comm_,
@@ -374,44 +375,82 @@ void MpiDomain::exchange_halo(ParticleStore& p) {
   for (int q = 0; q < size_; ++q) send_n[static_cast<std::size_t>(q)] = static_cast<long long>(to[static_cast<std::size_t>(q)].size());
   MPI_Alltoall(send_n.data(), 1, MPI_LONG_LONG, recv_n.data(), 1, MPI_LONG_LONG, comm_);
   halo_ = Plan{};
+  all_peers_ = size_ <= kAllPeersRanks;
   for (int q = 0; q < size_; ++q) {
     const std::size_t u = static_cast<std::size_t>(q);
-    if (q == rank_ || (send_n[u] == 0 && recv_n[u] == 0)) continue;
+    if (q == rank_ || (!all_peers_ && send_n[u] == 0 && recv_n[u] == 0)) continue;
     halo_.peers.push_back(q);
     halo_.send.push_back(std::move(to[u]));
     halo_.recv_count.push_back(static_cast<std::size_t>(recv_n[u]));
   }
+  halo_sources_.clear();
+  for (const auto& list : halo_.send) halo_sources_.insert(halo_sources_.end(), list.begin(), list.end());
+  std::sort(halo_sources_.begin(), halo_sources_.end());
+  halo_sources_.erase(std::unique(halo_sources_.begin(), halo_sources_.end()), halo_sources_.end());
   std::size_t n_ghost = 0;
   for (std::size_t c : halo_.recv_count) n_ghost += c;
   p.add_ghosts(n_ghost);
-  fill_ghosts(p, p.fields());
+  fill_ghosts(p, p.fields(), p.fields());
   stats_.ghosts = static_cast<std::int64_t>(n_ghost);
 }
 
 void MpiDomain::refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) {
   if (halo_.peers.empty()) return;  // one rank, or no neighbour within the halo
   CommTimer timer(stats_.comm_seconds);
-  fill_ghosts(p, fields);
+  fill_ghosts(p, fields, fields);
 }
 
-void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) {
+void MpiDomain::exchange_step(ParticleStore& p, std::span<FieldBase* const> send_fields,
+                              std::span<FieldBase* const> recv_fields, std::span<double> values) {
+  if (size_ == 1) return;
+  CommTimer timer(stats_.comm_seconds);
+  if (all_peers_) {
+    fill_ghosts(p, send_fields, recv_fields, values);
+    return;
+  }
+  fill_ghosts(p, send_fields, recv_fields);
+  // A NaN must win on every rank, and MPI_MAX may drop it: it travels as a flag beside the value.
+  const std::size_t n = values.size();
+  std::vector<double> both(2 * n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const bool nan = std::isnan(values[v]);
+    both[v] = nan ? -std::numeric_limits<double>::infinity() : values[v];
+    both[n + v] = nan ? 1.0 : 0.0;
+  }
+  max(both);
+  for (std::size_t v = 0; v < n; ++v) values[v] = both[n + v] > 0.0 ? std::nan("") : both[v];
+}
+
+void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> send_fields,
+                            std::span<FieldBase* const> recv_fields, std::span<double> values) {
   std::size_t bpi = 0;
-  for (const FieldBase* f : fields) bpi += f->bytes_per_item();
+  for (const FieldBase* f : send_fields) bpi += f->bytes_per_item();
+  const std::size_t header = values.size_bytes();
   const std::size_t np = halo_.peers.size();
   // Buffers kept between calls: the halo refresh runs every step.
   std::vector<std::vector<std::byte>>& send = send_buffers_;
   std::vector<std::vector<std::byte>>& recv = recv_buffers_;
   send.resize(np);
   for (std::size_t u = 0; u < np; ++u) {
-    send[u].resize(halo_.send[u].size() * bpi);
-    std::byte* out = send[u].data();
-    for (const std::int32_t k : halo_.send[u]) out = pack_fields(fields, static_cast<std::size_t>(k), out);
+    send[u].resize(header + halo_.send[u].size() * bpi);
+    if (header) std::memcpy(send[u].data(), values.data(), header);
+    // Field by field (one virtual call each), not particle by particle.
+    std::byte* out = send[u].data() + header;
+    for (const FieldBase* f : send_fields) out = f->pack_items(halo_.send[u], out);
   }
-  transport(halo_, bpi, send, recv);
+  transport(halo_, header, bpi, send, recv);
   std::size_t slot = p.n_owned();
   for (std::size_t u = 0; u < np; ++u) {
     const std::byte* in = recv[u].data();
-    for (std::size_t c = 0; c < halo_.recv_count[u]; ++c, ++slot) in = unpack_fields(fields, slot, in);
+    for (std::size_t v = 0; v < values.size(); ++v) {
+      double theirs;
+      std::memcpy(&theirs, in + v * sizeof(double), sizeof(double));
+      // Order-independent maximum that keeps a NaN from any rank.
+      if (std::isnan(theirs) || theirs > values[v]) values[v] = std::isnan(values[v]) ? values[v] : theirs;
+    }
+    in += header;
+    for (FieldBase* f : recv_fields) in = f->unpack_items(slot, halo_.recv_count[u], in);
+    slot += halo_.recv_count[u];
   }
 }
 

@@ -27,6 +27,12 @@
 // when max/mean over ranks exceeds `repartition_threshold` and at least `repartition_gap`
 // rebuilds passed since the last partition (hysteresis), the next migrate() repartitions.
 //
+// One round per step. With few ranks (at most kAllPeersRanks) every rank is a halo peer of
+// every other, even with no ghosts to send, so that exchange_step() can carry the step's
+// reduction (a handful of doubles) in the same messages as the ghosts' next state: one
+// synchronisation per velocity-Verlet step. With more ranks the peers are the neighbours only
+// and exchange_step() is the ghost refresh plus an MPI_Allreduce.
+//
 // Reductions are exact (max, logical or, integer sums) or order-fixed (double sums gathered and
 // added in rank order), so they give the same bits on every rank.
 #pragma once
@@ -34,6 +40,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -83,6 +90,12 @@ class MpiDomain final : public Domain {
   void exchange_halo(ParticleStore& p) override;
   void refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) override;
   void report_work(double work) override;
+  std::span<const std::int32_t> halo_sources() const override { return halo_sources_; }
+  void exchange_step(ParticleStore& p, std::span<FieldBase* const> send_fields,
+                     std::span<FieldBase* const> recv_fields, std::span<double> values) override;
+
+  // Up to this many ranks, the halo plan lists every other rank as a peer (see above).
+  static constexpr int kAllPeersRanks = 4;
 
   const SectorPartition& partition() const { return partition_; }
   // The rank owning a point (its sector's part).
@@ -103,9 +116,13 @@ class MpiDomain final : public Domain {
   };
   void repartition(const ParticleStore& p);
   void rebuild_wedges();
-  void fill_ghosts(ParticleStore& p, std::span<FieldBase* const> fields);
-  // Point-to-point exchange of one plan's bytes: `bytes_per_item` per listed index.
-  void transport(const Plan& plan, std::size_t bytes_per_item,
+  // Ghosts' `recv_fields` from their owners' `send_fields`; `values`, when not empty, travel
+  // ahead of the ghosts in every message and are maximised (all ranks must be peers).
+  void fill_ghosts(ParticleStore& p, std::span<FieldBase* const> send_fields,
+                   std::span<FieldBase* const> recv_fields, std::span<double> values = {});
+  // Point-to-point exchange of one plan's bytes: `header_bytes` then `bytes_per_item` per
+  // listed index.
+  void transport(const Plan& plan, std::size_t header_bytes, std::size_t bytes_per_item,
                  const std::vector<std::vector<std::byte>>& send,
                  std::vector<std::vector<std::byte>>& recv);
   // Collective: throws std::runtime_error with the first failing rank's message on every rank.
@@ -120,6 +137,8 @@ class MpiDomain final : public Domain {
   double halo_width_ = 0.0;
   std::int64_t total_particles_ = 0;
   Plan halo_;
+  std::vector<std::int32_t> halo_sources_;  // union of halo_.send, ascending
+  bool all_peers_ = false;                   // every other rank is in halo_.peers
   std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
   std::vector<MPI_Request> requests_;
   bool repartition_due_ = false;

@@ -4,7 +4,8 @@
 //  - Routing and ghost sets: particles placed at the drum centre, on sector edges and along
 //    the wall; every rank checks that it owns exactly the particles whose sector is its own,
 //    holds as ghosts exactly the others within the halo width of its wedge (a true distance),
-//    that each ghost came from its owner (origin rank in the plan) and carries its owner's data.
+//    that each ghost came from its owner (origin rank in the plan) and carries its owner's data;
+//    the end-of-step round (ghosts' next state and the step's reduction in one exchange).
 //  - Migration: a particle pushed across a boundary arrives with every field and its contact
 //    histories; none is lost or duplicated; a particle that jumps past the halo is an error
 //    with the same message on every rank.
@@ -20,6 +21,7 @@
 #include <cstring>
 #include <map>
 #include <set>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -115,6 +117,65 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
     EXPECT_EQ(std::memcmp(&p.vel[k], &all.vel[src], sizeof(Vec2)), 0);
     EXPECT_EQ(p.omega[k], all.omega[src]);
     EXPECT_EQ(p.mass[k], all.mass[src]);
+  }
+}
+
+// The end-of-step round of velocity Verlet (Domain::exchange_step): the ghosts receive their
+// owners' prepared fields (here: position + (id, 0), spin = 10 id), read from exactly the
+// halo sources, and the values are maximised over ranks in the same messages, a NaN on one
+// rank giving NaN on all.
+TEST(Decomposition, EndOfStepRoundCarriesGhostsAndTheReduction) {
+  const int rank = world_rank(), size = world_size();
+  DecompositionOptions opt;
+  opt.has_center = true;
+  MpiDomain domain(MPI_COMM_WORLD, opt);
+  ParticleStore all, p;
+  const int n_sectors = 16 * size;
+  place_probe_particles(all, n_sectors);
+  place_probe_particles(p, n_sectors);
+  const double halo = 0.05;
+  domain.adopt(p, halo);
+  domain.exchange_halo(p);
+  const SectorPartition& part = domain.partition();
+
+  // Halo sources: ascending, and exactly the owned particles within the halo of another rank.
+  const std::span<const std::int32_t> sources = domain.halo_sources();
+  EXPECT_TRUE(std::is_sorted(sources.begin(), sources.end()));
+  std::set<std::int64_t> got, want;
+  for (const std::int32_t k : sources) got.insert(p.id[static_cast<std::size_t>(k)]);
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    for (int q = 0; q < size; ++q)
+      if (q != rank && distance_to_part(p.pos[k], {}, part, q) < halo) want.insert(p.id[k]);
+  EXPECT_EQ(got.size(), sources.size()) << "no repeats";
+  EXPECT_EQ(got, want);
+
+  std::vector<FieldBase*> registry;
+  Field<Vec2> next_pos{"next_position", registry};
+  Field<double> next_spin{"next_spin", registry};
+  for (FieldBase* f : registry) f->resize(p.n_owned());
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {  // NaN except at the sources: must not travel
+    next_pos[k] = {std::nan(""), std::nan("")};
+    next_spin[k] = std::nan("");
+  }
+  for (const std::int32_t k : sources) {
+    const std::size_t u = static_cast<std::size_t>(k);
+    next_pos[u] = p.pos[u] + Vec2{static_cast<double>(p.id[u]), 0.0};
+    next_spin[u] = 10.0 * static_cast<double>(p.id[u]);
+  }
+  const std::vector<FieldBase*> recv = {&p.pos, &p.omega};
+  double values[3] = {static_cast<double>(rank), -static_cast<double>(rank),
+                      rank == size - 1 ? std::nan("") : 0.0};
+  domain.exchange_step(p, registry, recv, values);
+  EXPECT_EQ(values[0], size - 1);
+  EXPECT_EQ(values[1], 0.0);
+  EXPECT_TRUE(std::isnan(values[2])) << "a NaN on the last rank reaches rank " << rank;
+  for (std::size_t g = 0; g < p.n_ghost(); ++g) {
+    const std::size_t k = p.n_owned() + g;
+    const std::size_t src = static_cast<std::size_t>(p.id[k]);  // ids are indices in `all`
+    const Vec2 want_pos = all.pos[src] + Vec2{static_cast<double>(p.id[k]), 0.0};
+    EXPECT_EQ(std::memcmp(&p.pos[k], &want_pos, sizeof(Vec2)), 0) << "ghost " << p.id[k];
+    EXPECT_EQ(p.omega[k], 10.0 * static_cast<double>(p.id[k])) << "ghost " << p.id[k];
+    EXPECT_EQ(std::memcmp(&p.vel[k], &all.vel[src], sizeof(Vec2)), 0) << "fields not listed stay";
   }
 }
 
