@@ -267,6 +267,7 @@ int run(const Options& opt) {
     info.extra.emplace_back("rank_ghosts", list(ghosts, "%.0f"));
     info.extra.emplace_back("rank_comm_seconds", list(comm, "%.4g"));
     info.extra.emplace_back("imbalance", fmt_double("%.4g", ds.imbalance_work));
+    info.extra.emplace_back("imbalance_mean", fmt_double("%.4g", ds.imbalance_mean()));
     info.extra.emplace_back("imbalance_equal_angle", fmt_double("%.4g", ds.imbalance_equal_angle));
     info.extra.emplace_back("partitions", std::to_string(ds.partitions));
     info.extra.emplace_back("partition_method", "\"" + ds.method + "\"");

@@ -76,9 +76,12 @@ class Domain {
   // owner's `send_fields` (same types, in the same order; only halo_sources() are read).
   virtual void exchange_step(ParticleStore& /*p*/, std::span<FieldBase* const> /*send_fields*/,
                              std::span<FieldBase* const> /*recv_fields*/, std::span<double> /*values*/) {}
-  // Called after each neighbour rebuild with this rank's work (owned particles + listed pairs);
-  // a parallel domain may repartition at its next migrate() when the imbalance grew.
-  virtual void report_work(double /*work*/) {}
+  // Called after each neighbour rebuild with the work of each owned particle (1 + its share
+  // of the listed pairs: half of a pair between two owned particles, all of a pair with a
+  // ghost, which both ranks compute), in store order; the rank's work is their sum. A parallel
+  // domain weights the sectors with it and may repartition at its next migrate() when the
+  // imbalance grew.
+  virtual void report_work(std::span<const double> /*particle_work*/) {}
 };
 
 }  // namespace dem2d

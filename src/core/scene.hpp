@@ -57,7 +57,7 @@ struct RunSpec {
   double dt_safety = 0.2;          // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
   bool allow_unsafe_dt = false;    // run anyway (with a warning) when dt exceeds the safe bound
   int sectors_per_rank = 32;       // parallel runs: angular sectors per rank (METIS groups them)
-  double repartition_threshold = 1.2;  // parallel runs: max/mean work that triggers a repartition
+  double repartition_threshold = 1.05;  // parallel runs: max/mean work that triggers a repartition
 };
 
 struct ContactSpec {

@@ -452,7 +452,18 @@ void Simulation::rebuild() {
   }
   ghosts_ahead_ = false;
   search_.build(particles_, walls_, skin_, pairs_, wall_pairs_);
-  if (parallel) domain_->report_work(static_cast<double>(particles_.n_owned() + pairs_.size()));
+  if (parallel) {
+    // Multiples of 1/2: the sector weights built from them add exactly in any order.
+    const std::size_t n_owned = particles_.n_owned();
+    particle_work_.assign(n_owned, 1.0);
+    for (std::size_t k = 0; k < pairs_.size(); ++k) {
+      const auto i = static_cast<std::size_t>(pairs_.i[k]), j = static_cast<std::size_t>(pairs_.j[k]);
+      const bool both = i < n_owned && j < n_owned;
+      if (i < n_owned) particle_work_[i] += both ? 0.5 : 1.0;
+      if (j < n_owned) particle_work_[j] += both ? 0.5 : 1.0;
+    }
+    domain_->report_work(particle_work_);
+  }
   pos_at_build_.assign(particles_.pos.data(), particles_.pos.data() + particles_.n_owned());
   drum_angle_at_build_ = walls_.drum_angle();
   time_at_build_ = time_;

@@ -161,6 +161,7 @@ class Simulation {
   Field<Vec2> next_vel_{"next_velocity", next_registry_};
   Field<double> next_omega_{"next_spin", next_registry_};
   bool ghosts_ahead_ = false;  // the ghosts already hold the coming step's drifted state
+  std::vector<double> particle_work_;  // parallel: reported at each rebuild (Domain::report_work)
   Vec2 gravity_{};
 
   // Rebuild bookkeeping: positions and wall pose at the last build.

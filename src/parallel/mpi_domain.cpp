@@ -116,18 +116,20 @@ void MpiDomain::rebuild_wedges() {
   }
 }
 
-// Sector weights (owned particles per sector) and boundary weights (particles within the halo
-// width of each boundary ray), summed over ranks: integer-valued doubles, so the sums are exact
-// in any order and every rank sees the same numbers. Rank 0 partitions and broadcasts.
+// Sector weights (the work of the owned particles in each sector, as last reported, or their
+// count) and boundary weights (particles within the halo width of each boundary ray), summed
+// over ranks: multiples of 1/2, so the sums are exact in any order and every rank sees the same
+// numbers. Rank 0 partitions and broadcasts.
 void MpiDomain::repartition(const ParticleStore& p) {
   const int n = options_.sectors_per_rank * size_;
   const double step = kTwoPi / n;
   std::vector<Vec2> ray(static_cast<std::size_t>(n) + 1);  // unit direction of boundary ray s
   for (int s = 0; s <= n; ++s) ray[static_cast<std::size_t>(s)] = {std::cos(s * step), std::sin(s * step)};
   std::vector<double> weights(2 * static_cast<std::size_t>(n), 0.0);  // work, then boundaries
+  const bool have_work = particle_work_.size() == p.n_owned();
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const int s = sector_of(p.pos[k], options_.center, n);
-    weights[static_cast<std::size_t>(s)] += 1.0;
+    weights[static_cast<std::size_t>(s)] += have_work ? particle_work_[k] : 1.0;
     // Boundary ray s lies between sectors s - 1 and s: edge s - 1; ray s + 1: edge s.
     if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s)]) < halo_width_)
       weights[static_cast<std::size_t>(n + (s + n - 1) % n)] += 1.0;
@@ -201,13 +203,18 @@ void MpiDomain::adopt(ParticleStore& p, double halo_width) {
     throw std::logic_error("MpiDomain::adopt: particles lost or duplicated");
 }
 
-void MpiDomain::report_work(double work) {
+void MpiDomain::report_work(std::span<const double> particle_work) {
+  particle_work_.assign(particle_work.begin(), particle_work.end());
+  double work = 0.0;
+  for (const double w : particle_work) work += w;
   stats_.work = work;
   double in[2] = {work, -work}, out[2] = {0.0, 0.0};
   MPI_Allreduce(in, out, 2, MPI_DOUBLE, MPI_MAX, comm_);
   const double total = sum(work);
   const double mean = total / size_;
   stats_.imbalance_work = mean > 0.0 ? out[0] / mean : 1.0;
+  stats_.imbalance_sum += stats_.imbalance_work;
+  stats_.reports += 1;
   ++rebuilds_since_partition_;
   repartition_due_ = stats_.imbalance_work > options_.repartition_threshold &&
                      rebuilds_since_partition_ >= options_.repartition_gap;
@@ -310,6 +317,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
   const std::vector<std::byte> arrived_records = exchange(record_bytes_out);
 
   // Drop the leavers, append the arrivals, keep the owned particles in id order.
+  particle_work_.clear();  // indexed by the old store order
   p.remove_if(leaving);
   const std::size_t n_new = arrived.size() / bpp;
   const std::size_t first = p.add_owned(n_new);

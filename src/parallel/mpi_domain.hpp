@@ -23,7 +23,9 @@
 // particle count is compared before and after every migration. Errors are agreed on: every
 // rank throws the same message.
 //
-// Load balance. After each rebuild the core reports its work (owned particles + listed pairs);
+// Load balance. After each rebuild the core reports the work of each owned particle (1 + its
+// share of the listed pairs); the sector weights are these summed by sector, so a dense pile
+// weighs more than the same number of balls in flight;
 // when max/mean over ranks exceeds `repartition_threshold` and at least `repartition_gap`
 // rebuilds passed since the last partition (hysteresis), the next migrate() repartitions.
 //
@@ -57,7 +59,7 @@ struct DecompositionOptions {
   // settled charge within 5 % from 4 ranks up (granularity), 24 can, and from 32 METIS's
   // own grouping is mostly kept.
   int sectors_per_rank = 32;
-  double repartition_threshold = 1.2; // max/mean work that triggers a repartition
+  double repartition_threshold = 1.05; // max/mean work that triggers a repartition
   int repartition_gap = 10;           // rebuilds between two partitions at least
 };
 
@@ -66,6 +68,9 @@ struct DecompositionStats {
   int partitions = 0;                 // METIS partitions computed (1 = the initial one)
   std::string method;                 // how the last partition was found
   double imbalance_work = 1.0;        // max/mean of the last reported work
+  double imbalance_sum = 0.0;         // sum of imbalance_work over the rebuilds so far
+  std::int64_t reports = 0;           // rebuilds reported
+  double imbalance_mean() const { return reports ? imbalance_sum / static_cast<double>(reports) : 1.0; }
   double imbalance_equal_angle = 1.0; // the same for equal-angle arcs at the last partition
   double imbalance_partition = 1.0;   // predicted (sector weights) at the last partition
   std::int64_t migrated = 0;          // particles sent by this rank, all rebuilds
@@ -89,7 +94,7 @@ class MpiDomain final : public Domain {
   void migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) override;
   void exchange_halo(ParticleStore& p) override;
   void refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) override;
-  void report_work(double work) override;
+  void report_work(std::span<const double> particle_work) override;
   std::span<const std::int32_t> halo_sources() const override { return halo_sources_; }
   void exchange_step(ParticleStore& p, std::span<FieldBase* const> send_fields,
                      std::span<FieldBase* const> recv_fields, std::span<double> values) override;
@@ -141,6 +146,7 @@ class MpiDomain final : public Domain {
   bool all_peers_ = false;                   // every other rank is in halo_.peers
   std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
   std::vector<MPI_Request> requests_;
+  std::vector<double> particle_work_;  // last reported, per owned particle, until the next migrate
   bool repartition_due_ = false;
   int rebuilds_since_partition_ = 0;
   DecompositionStats stats_;
