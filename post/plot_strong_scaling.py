@@ -39,7 +39,7 @@ def main():
     ax1.set_ylabel("speedup over 1 rank")
     ax1.legend()
     ax2.set_xlabel("ranks")
-    ax2.set_ylabel("time in halo/migration (% of wall)")
+    ax2.set_ylabel("time in communication (% of wall)")
     ax2.legend()
     fig.suptitle("dem2d strong scaling (angular sectors, METIS)")
     fig.tight_layout()
