@@ -71,18 +71,32 @@ void place_probe_particles(ParticleStore& p, int n_sectors) {
   for (int k = -20; k <= 20; ++k) p.add(id++, 0, r, 7800.0, {0.045 * k, 0.002 * k}, {}, 0.0);
 }
 
+// The probe particles on every rank (`all`) and decomposed about the origin (`p`: this rank's
+// own, then the ghosts within `halo` of its wedge).
+struct ProbeScene {
+  explicit ProbeScene(double halo_width) : domain(MPI_COMM_WORLD, centred()), halo(halo_width) {
+    place_probe_particles(all, 16 * world_size());
+    place_probe_particles(p, 16 * world_size());
+    domain.adopt(p, halo);
+    domain.exchange_halo(p);
+  }
+  static DecompositionOptions centred() {
+    DecompositionOptions opt;
+    opt.has_center = true;
+    return opt;
+  }
+  MpiDomain domain;
+  ParticleStore all, p;
+  double halo;
+};
+
 TEST(Decomposition, OwnershipAndExactGhostSets) {
   const int rank = world_rank(), size = world_size();
-  DecompositionOptions opt;
-  opt.has_center = true;
-  MpiDomain domain(MPI_COMM_WORLD, opt);
-  ParticleStore all, p;
-  const int n_sectors = 16 * size;
-  place_probe_particles(all, n_sectors);
-  place_probe_particles(p, n_sectors);
-  const double halo = 0.05;
-  domain.adopt(p, halo);
-  domain.exchange_halo(p);
+  ProbeScene scene(0.05);
+  MpiDomain& domain = scene.domain;
+  const ParticleStore& all = scene.all;
+  ParticleStore& p = scene.p;
+  const double halo = scene.halo;
   const SectorPartition& part = domain.partition();
   ASSERT_TRUE(is_valid(part));
   ASSERT_EQ(part.parts(), size);
@@ -126,16 +140,11 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
 // rank giving NaN on all.
 TEST(Decomposition, EndOfStepRoundCarriesGhostsAndTheReduction) {
   const int rank = world_rank(), size = world_size();
-  DecompositionOptions opt;
-  opt.has_center = true;
-  MpiDomain domain(MPI_COMM_WORLD, opt);
-  ParticleStore all, p;
-  const int n_sectors = 16 * size;
-  place_probe_particles(all, n_sectors);
-  place_probe_particles(p, n_sectors);
-  const double halo = 0.05;
-  domain.adopt(p, halo);
-  domain.exchange_halo(p);
+  ProbeScene scene(0.05);
+  MpiDomain& domain = scene.domain;
+  const ParticleStore& all = scene.all;
+  ParticleStore& p = scene.p;
+  const double halo = scene.halo;
   const SectorPartition& part = domain.partition();
 
   // Halo sources: ascending, and exactly the owned particles within the halo of another rank.
