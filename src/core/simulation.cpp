@@ -463,6 +463,7 @@ void Simulation::rebuild() {
       if (j < n_owned) particle_work_[j] += both ? 0.5 : 1.0;
     }
     domain_->report_work(particle_work_);
+    for (FieldBase* f : next_registry_) f->resize(n_owned);  // sized with the owned set, here
   }
   pos_at_build_.assign(particles_.pos.data(), particles_.pos.data() + particles_.n_owned());
   drum_angle_at_build_ = walls_.drum_angle();
@@ -741,10 +742,6 @@ void Simulation::check_stability() {
     // step_verlet, operation for operation, so the bits agree), and the next step skips the
     // refresh. Wasted when the next step rebuilds (one step in a hundred or more).
     const std::span<const std::int32_t> sources = domain_->halo_sources();
-    const std::size_t n = particles_.n_owned();
-    if (next_pos_.size() < n) {
-      for (FieldBase* f : next_registry_) f->resize(n);
-    }
     const double h = 0.5 * dt_;
     const Vec2* x = particles_.pos.data();
     const Vec2* v = particles_.vel.data();

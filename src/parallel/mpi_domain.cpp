@@ -419,7 +419,8 @@ void MpiDomain::exchange_step(ParticleStore& p, std::span<FieldBase* const> send
   fill_ghosts(p, send_fields, recv_fields);
   // A NaN must win on every rank, and MPI_MAX may drop it: it travels as a flag beside the value.
   const std::size_t n = values.size();
-  std::vector<double> both(2 * n);
+  std::vector<double>& both = reduce_buffer_;  // kept between steps
+  both.resize(2 * n);
   for (std::size_t v = 0; v < n; ++v) {
     const bool nan = std::isnan(values[v]);
     both[v] = nan ? -std::numeric_limits<double>::infinity() : values[v];

@@ -146,6 +146,7 @@ class MpiDomain final : public Domain {
   bool all_peers_ = false;                   // every other rank is in halo_.peers
   std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
   std::vector<MPI_Request> requests_;
+  std::vector<double> reduce_buffer_;  // exchange_step without all peers: values and NaN flags
   std::vector<double> particle_work_;  // last reported, per owned particle, until the next migrate
   bool repartition_due_ = false;
   int rebuilds_since_partition_ = 0;

@@ -93,10 +93,7 @@ struct ProbeScene {
 TEST(Decomposition, OwnershipAndExactGhostSets) {
   const int rank = world_rank(), size = world_size();
   ProbeScene scene(0.05);
-  MpiDomain& domain = scene.domain;
-  const ParticleStore& all = scene.all;
-  ParticleStore& p = scene.p;
-  const double halo = scene.halo;
+  auto& [domain, all, p, halo] = scene;
   const SectorPartition& part = domain.partition();
   ASSERT_TRUE(is_valid(part));
   ASSERT_EQ(part.parts(), size);
@@ -141,10 +138,7 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
 TEST(Decomposition, EndOfStepRoundCarriesGhostsAndTheReduction) {
   const int rank = world_rank(), size = world_size();
   ProbeScene scene(0.05);
-  MpiDomain& domain = scene.domain;
-  const ParticleStore& all = scene.all;
-  ParticleStore& p = scene.p;
-  const double halo = scene.halo;
+  auto& [domain, all, p, halo] = scene;
   const SectorPartition& part = domain.partition();
 
   // Halo sources: ascending, and exactly the owned particles within the halo of another rank.
