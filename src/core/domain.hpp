@@ -23,21 +23,10 @@
 #include <span>
 #include <vector>
 
-#include "core/contact_models.hpp"
+#include "core/contact_history.hpp"
 #include "core/particles.hpp"
 
 namespace dem2d {
-
-// A contact history keyed by particle ids, so that it can travel with its particle.
-// b >= 0: the pair (a, b) with a < b; b < 0: particle a against wall element -1 - b.
-struct HistoryRecord {
-  std::int64_t a = 0;
-  std::int64_t b = 0;
-  ContactHistory h{};
-  friend bool operator<(const HistoryRecord& x, const HistoryRecord& y) {
-    return x.a < y.a || (x.a == y.a && x.b < y.b);
-  }
-};
 
 class Domain {
  public:
@@ -62,7 +51,7 @@ class Domain {
   // that involve a leaving particle travel with it. On return it holds, sorted and without
   // duplicates, every history this rank needs for the particles it now owns. Throws
   // std::runtime_error (on every rank alike) when a particle jumped farther than the halo.
-  virtual void migrate(ParticleStore&, std::vector<HistoryRecord>& /*histories*/) {}
+  virtual void migrate(ParticleStore&, HistoryRecords& /*histories*/) {}
   // Rebuild the ghost copies of other ranks' particles within the halo width of this rank's
   // region (all registered fields). Ghosts follow the owned particles in the store.
   virtual void exchange_halo(ParticleStore&) {}

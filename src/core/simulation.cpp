@@ -445,7 +445,7 @@ void Simulation::rebuild() {
   if (parallel) {
     // Particles that left this rank's region move to their owner with their contact
     // histories; then a new ghost set; the lists below take their histories from the records.
-    std::vector<HistoryRecord> records = history_records();
+    HistoryRecords records = history_records();
     domain_->migrate(particles_, records);
     domain_->exchange_halo(particles_);
     adopt_history_records(records);
@@ -479,32 +479,33 @@ bool Simulation::rebuild_needed(double disp) const {
   return domain_->any(2.0 * disp + wall_move >= skin_);
 }
 
-std::vector<HistoryRecord> Simulation::history_records() const {
-  std::vector<HistoryRecord> out;
+HistoryRecords Simulation::history_records() const {
+  HistoryRecords out(2);
   const auto live = [](const ContactHistory& h) { return h.xi != 0.0 || h.m_roll != 0.0; };
   for (std::size_t k = 0; k < pairs_.size(); ++k)
-    if (live(pairs_.history[k])) out.push_back({pairs_.id_i[k], pairs_.id_j[k], pairs_.history[k]});
+    if (live(pairs_.history[k])) out.push_back(pairs_.id_i[k], pairs_.id_j[k], &pairs_.history[k].xi);
   for (std::size_t k = 0; k < wall_pairs_.size(); ++k)
     if (live(wall_pairs_.history[k]))
-      out.push_back({wall_pairs_.id[k], -1 - static_cast<std::int64_t>(wall_pairs_.element[k]),
-                     wall_pairs_.history[k]});
+      out.push_back(wall_pairs_.id[k], -1 - static_cast<std::int64_t>(wall_pairs_.element[k]),
+                    &wall_pairs_.history[k].xi);
   return out;
 }
 
-void Simulation::adopt_history_records(const std::vector<HistoryRecord>& records) {
+void Simulation::adopt_history_records(const HistoryRecords& records) {
   // The lists become key + history only: NeighborSearch::build carries histories from the
   // old lists by key (pairs sorted by (id_i, id_j), walls by (id, element)).
   PairList pl;
   WallPairList wl;
-  for (const HistoryRecord& r : records) {
-    if (r.b >= 0) {
-      pl.id_i.push_back(r.a);
-      pl.id_j.push_back(r.b);
-      pl.history.push_back(r.h);
+  for (std::size_t r = 0; r < records.size(); ++r) {
+    const ContactHistory h{records.values(r)[0], records.values(r)[1]};
+    if (records.b(r) >= 0) {
+      pl.id_i.push_back(records.a(r));
+      pl.id_j.push_back(records.b(r));
+      pl.history.push_back(h);
     } else {
-      wl.id.push_back(r.a);
-      wl.element.push_back(static_cast<std::int32_t>(-1 - r.b));
-      wl.history.push_back(r.h);
+      wl.id.push_back(records.a(r));
+      wl.element.push_back(static_cast<std::int32_t>(-1 - records.b(r)));
+      wl.history.push_back(h);
     }
   }
   // Records are sorted by (a, b); wall keys need (id, element) order: b = -1 - element runs

@@ -126,8 +126,8 @@ class Simulation {
   void step_iterative();
   bool rebuild_needed(double max_displacement) const;
   // Contact histories keyed by ids (parallel rebuilds: they travel with migrating particles).
-  std::vector<HistoryRecord> history_records() const;
-  void adopt_history_records(const std::vector<HistoryRecord>& records);
+  HistoryRecords history_records() const;
+  void adopt_history_records(const HistoryRecords& records);
   void check_stability();
   void save_backup();
   void restore_backup();

@@ -232,7 +232,7 @@ std::vector<double> MpiDomain::gather_work() const {
   return all;
 }
 
-void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) {
+void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   CommTimer timer(stats_.comm_seconds);
   p.clear_ghosts();
   const bool repartitioned = repartition_due_;
@@ -260,7 +260,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
   // Particles and their histories, per destination rank.
   const std::size_t bpp = p.bytes_per_particle();
   std::vector<std::vector<std::byte>> send_particles(static_cast<std::size_t>(size_));
-  std::vector<std::vector<HistoryRecord>> send_records(static_cast<std::size_t>(size_));
+  std::vector<std::vector<std::byte>> send_records(static_cast<std::size_t>(size_));
   std::unordered_map<std::int64_t, int> dest_of_leaving;
   for (std::size_t k = 0; k < n; ++k) {
     if (!leaving[k]) continue;
@@ -270,13 +270,19 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
     pack_fields(p.fields(), k, buf.data() + at);
     dest_of_leaving.emplace(p.id[k], dest[k]);
   }
-  for (const HistoryRecord& r : histories) {
+  const std::size_t record_bytes = histories.record_bytes();
+  const auto send_record = [&](int q, std::size_t r) {
+    auto& buf = send_records[static_cast<std::size_t>(q)];
+    buf.resize(buf.size() + record_bytes);
+    histories.pack(r, buf.data() + buf.size() - record_bytes);
+  };
+  for (std::size_t r = 0; r < histories.size(); ++r) {
     int da = -1, db = -1;
-    if (auto it = dest_of_leaving.find(r.a); it != dest_of_leaving.end()) da = it->second;
-    if (r.b >= 0)
-      if (auto it = dest_of_leaving.find(r.b); it != dest_of_leaving.end()) db = it->second;
-    if (da >= 0) send_records[static_cast<std::size_t>(da)].push_back(r);
-    if (db >= 0 && db != da) send_records[static_cast<std::size_t>(db)].push_back(r);
+    if (auto it = dest_of_leaving.find(histories.a(r)); it != dest_of_leaving.end()) da = it->second;
+    if (histories.b(r) >= 0)
+      if (auto it = dest_of_leaving.find(histories.b(r)); it != dest_of_leaving.end()) db = it->second;
+    if (da >= 0) send_record(da, r);
+    if (db >= 0 && db != da) send_record(db, r);
   }
   stats_.migrated += static_cast<std::int64_t>(dest_of_leaving.size());
 
@@ -307,14 +313,7 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
     return flat_recv;
   };
   const std::vector<std::byte> arrived = exchange(send_particles);
-  std::vector<std::vector<std::byte>> record_bytes_out(static_cast<std::size_t>(size_));
-  for (int q = 0; q < size_; ++q) {
-    const auto& rs = send_records[static_cast<std::size_t>(q)];
-    auto& b = record_bytes_out[static_cast<std::size_t>(q)];
-    b.resize(rs.size() * sizeof(HistoryRecord));
-    if (!rs.empty()) std::memcpy(b.data(), rs.data(), b.size());
-  }
-  const std::vector<std::byte> arrived_records = exchange(record_bytes_out);
+  const std::vector<std::byte> arrived_records = exchange(send_records);
 
   // Drop the leavers, append the arrivals, keep the owned particles in id order.
   particle_work_.clear();  // indexed by the old store order
@@ -328,14 +327,8 @@ void MpiDomain::migrate(ParticleStore& p, std::vector<HistoryRecord>& histories)
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
     p.permute(order);
   }
-  const std::size_t n_rec = arrived_records.size() / sizeof(HistoryRecord);
-  const std::size_t had = histories.size();
-  histories.resize(had + n_rec);
-  if (n_rec) std::memcpy(static_cast<void*>(histories.data() + had), arrived_records.data(), n_rec * sizeof(HistoryRecord));
-  std::sort(histories.begin(), histories.end());
-  histories.erase(std::unique(histories.begin(), histories.end(),
-                              [](const HistoryRecord& x, const HistoryRecord& y) { return x.a == y.a && x.b == y.b; }),
-                  histories.end());
+  histories.unpack_append(arrived_records.data(), arrived_records.size());
+  histories.sort_unique();
 
   const std::int64_t total = sum(static_cast<std::int64_t>(p.n_owned()));
   if (total != total_particles_) {

@@ -91,7 +91,7 @@ class MpiDomain final : public Domain {
   void max(std::span<double> values) const override;
 
   void adopt(ParticleStore& p, double halo_width) override;
-  void migrate(ParticleStore& p, std::vector<HistoryRecord>& histories) override;
+  void migrate(ParticleStore& p, HistoryRecords& histories) override;
   void exchange_halo(ParticleStore& p) override;
   void refresh_ghosts(ParticleStore& p, std::span<FieldBase* const> fields) override;
   void report_work(std::span<const double> particle_work) override;

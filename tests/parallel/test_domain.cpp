@@ -196,17 +196,19 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
   // radii), and mark it: spin = its id, angle = the rank it started on.
   const double turn = 0.25 * kTwoPi / (16 * size);
   std::map<std::int64_t, int> started_on;
-  std::vector<HistoryRecord> records;
+  HistoryRecords records(2);
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Vec2 x = p.pos[k];
     p.pos[k] = {x.x * std::cos(turn) - x.y * std::sin(turn), x.x * std::sin(turn) + x.y * std::cos(turn)};
     p.omega[k] = static_cast<double>(p.id[k]);
     p.theta[k] = rank;
     // A history with the next particle and one with wall element 3, keyed by this id.
-    records.push_back({p.id[k], p.id[k] + 1, {1e-6 * static_cast<double>(p.id[k]), 2.0}});
-    records.push_back({p.id[k], -1 - 3, {3e-6, static_cast<double>(p.id[k])}});
+    const double pair_values[2] = {1e-6 * static_cast<double>(p.id[k]), 2.0};
+    const double wall_values[2] = {3e-6, static_cast<double>(p.id[k])};
+    records.push_back(p.id[k], p.id[k] + 1, pair_values);
+    records.push_back(p.id[k], -1 - 3, wall_values);
   }
-  std::sort(records.begin(), records.end());
+  records.sort_unique();
   domain.migrate(p, records);
   EXPECT_EQ(global_sum(static_cast<std::int64_t>(p.n_owned())), total);
   std::int64_t moved_here = 0;
@@ -215,14 +217,22 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
     EXPECT_EQ(p.omega[k], static_cast<double>(p.id[k])) << "fields travel with the particle";
     if (p.theta[k] != rank) ++moved_here;
     // Both of its records are here.
-    const HistoryRecord want_pair{p.id[k], p.id[k] + 1, {}}, want_wall{p.id[k], -4, {}};
-    EXPECT_TRUE(std::binary_search(records.begin(), records.end(), want_pair)) << "id " << p.id[k];
-    auto it = std::lower_bound(records.begin(), records.end(), want_wall);
-    ASSERT_TRUE(it != records.end() && it->a == p.id[k] && it->b == -4) << "id " << p.id[k];
-    EXPECT_EQ(it->h.m_roll, static_cast<double>(p.id[k]));
+    const auto find = [&](std::int64_t a, std::int64_t b) {
+      for (std::size_t r = 0; r < records.size(); ++r)
+        if (records.a(r) == a && records.b(r) == b) return static_cast<std::ptrdiff_t>(r);
+      return std::ptrdiff_t{-1};
+    };
+    EXPECT_GE(find(p.id[k], p.id[k] + 1), 0) << "id " << p.id[k];
+    const std::ptrdiff_t wall = find(p.id[k], -4);
+    ASSERT_GE(wall, 0) << "id " << p.id[k];
+    EXPECT_EQ(records.values(static_cast<std::size_t>(wall))[1], static_cast<double>(p.id[k]));
   }
   EXPECT_TRUE(std::is_sorted(p.id.data(), p.id.data() + p.n_owned()));
-  EXPECT_TRUE(std::is_sorted(records.begin(), records.end()));
+  bool sorted = true;
+  for (std::size_t r = 1; r < records.size(); ++r)
+    sorted = sorted && (records.a(r - 1) < records.a(r) ||
+                        (records.a(r - 1) == records.a(r) && records.b(r - 1) < records.b(r)));
+  EXPECT_TRUE(sorted) << "records sorted by key, without repeats";
   if (size > 1) EXPECT_GT(global_sum(moved_here), 0) << "the turn should move some particles";
   EXPECT_EQ(global_sum(moved_here), domain.sum(domain.stats().migrated));
 }
@@ -258,7 +268,7 @@ TEST(Decomposition, RepartitionBalancesReportedWorkNotCounts) {
   std::vector<double> work(p.n_owned());
   for (std::size_t k = 0; k < p.n_owned(); ++k) work[k] = weight(p.pos[k]);
   domain.report_work(work);
-  std::vector<HistoryRecord> records;
+  HistoryRecords records(2);
   domain.migrate(p, records);
   const double by_work = rank_work();
   EXPECT_EQ(domain.stats().partitions, 2);
@@ -278,7 +288,7 @@ TEST(Decomposition, AJumpPastTheHaloIsAnErrorOnEveryRank) {
   // The owner of the wall particle with the largest id throws it to the opposite side.
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     if (p.id[k] == 1 + 12 * ((16 * size + 2) / 3) + 20) p.pos[k] = -1.0 * p.pos[k];
-  std::vector<HistoryRecord> records;
+  HistoryRecords records(2);
   std::string what;
   try {
     domain.migrate(p, records);
