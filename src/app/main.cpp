@@ -94,7 +94,7 @@ void print_check(const Simulation& sim) {
   out += fmt_double("  steps:                 %.0f", steps) +
          fmt_double(" for %.4g s simulated\n", s.run.duration);
   const double bytes = static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
-                       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * sizeof(ContactHistory));
+                       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);
   out += fmt_double("  memory estimate:       %.1f MiB\n", 2.0 * bytes / (1024.0 * 1024.0));
   out += fmt_double("  neighbour skin:        %.4g m\n", sim.skin());
   say(out);

@@ -1,7 +1,7 @@
 // ContactBatch: the particle-particle contacts of one force evaluation, gathered into
 // contiguous arrays so that the contact law runs on SIMD packs (core/simd.hpp).
 //
-// The pair loop (simulation.cpp, force_kernel) runs in three phases:
+// The pair loop (contact_engine.cpp) runs in three phases:
 //   A. gather (scalar): for each candidate pair in canonical order, test for overlap and copy
 //      the inputs of the pairs in contact here;
 //   B. evaluate (SIMD): kinematics, contact law and rolling model, kPackSize contacts at a time
@@ -12,46 +12,60 @@
 // results do not depend on which lane a contact lands in.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <initializer_list>
 #include <vector>
 
 #include "core/array.hpp"
 
 namespace dem2d {
 
+// Most history slots a contact model may declare (law + rolling + tracker).
+inline constexpr std::size_t kMaxHistorySlots = 4;
+
+// The history columns of a batch: slot s of contact c is old[s][c] before the step, fresh[s][c]
+// after it.
+struct HistoryColumns {
+  std::array<Array<double>, kMaxHistorySlots> old, fresh;
+};
+
 struct ContactBatch {
   // Inputs (phase A).
   Array<std::int32_t> pair;   // index into the pair list
-  Array<std::int32_t> coeff;  // material pair index into the PairTable
+  Array<std::int32_t> coeff;  // material pair index into the coefficient table
   Array<double> dx, dy;       // x_j - x_i
   Array<double> dist2;        // |x_j - x_i|^2
   Array<double> r_i, r_j, m_i, m_j;
   Array<double> vx, vy;       // v_i - v_j
   Array<double> spin;         // w_i r_i + w_j r_j
   Array<double> omega_rel;    // w_i - w_j
-  Array<double> xi_old, mr_old;
   Array<double> counted;      // 1: this rank books the contact's energies and count, 0: not
+  HistoryColumns history;
   // Outputs (phase B).
   Array<double> fx, fy;       // force on i (on j: the opposite)
   Array<double> t_i, t_j;     // torques on i and on j
-  Array<double> xi_new, mr_new;
   Array<double> overlap;      // delta / min(r_i, r_j)
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
-    for (auto* v : {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
-                    &xi_old, &mr_old, &counted, &fx, &fy, &t_i, &t_j, &xi_new, &mr_new, &overlap})
-      v->resize(n);
+    for (auto* v : inputs()) v->resize(n);
+    for (auto* v : {&fx, &fy, &t_i, &t_j, &overlap}) v->resize(n);
+    for (auto& v : history.fresh) v.resize(n);
     pair.resize(n);
     coeff.resize(n);
   }
   // Copy contact `from` into slot `to` (padding).
   void copy(std::size_t to, std::size_t from) {
-    for (auto* v : {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
-                    &xi_old, &mr_old, &counted})
-      (*v)[to] = (*v)[from];
+    for (auto* v : inputs()) (*v)[to] = (*v)[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];
+  }
+
+ private:
+  std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
+    return {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel, &counted,
+            &history.old[0], &history.old[1], &history.old[2], &history.old[3]};
   }
 };
 
@@ -61,33 +75,38 @@ struct ContactBatch {
 struct WallBatch {
   // Inputs (phase A).
   Array<std::int32_t> pair;   // index into the wall pair list
-  Array<std::int32_t> coeff;  // material pair index into the PairTable
+  Array<std::int32_t> coeff;  // material pair index into the coefficient table
   Array<double> delta, nx, ny;  // overlap; unit normal from the sphere towards the wall
   Array<double> r, m;
   Array<double> vx, vy;       // v_rel = (v_i - v_wall) + w_i r_i t
   Array<double> omega_rel;    // w_i - Omega_wall
-  Array<double> xi_old, mr_old;
   Array<double> wx, wy;       // wall velocity at the contact point
   Array<double> px, py;       // contact point
+  HistoryColumns history;
   // Outputs (phase B).
   Array<double> fx, fy, torque, m_roll;
   Array<double> diss_law, el_law, diss_roll, el_roll;
-  Array<double> xi_new, mr_new;
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
-    for (auto* v : {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &xi_old, &mr_old, &wx, &wy,
-                    &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll,
-                    &el_roll, &xi_new, &mr_new})
+    for (auto* v : inputs()) v->resize(n);
+    for (auto* v : {&wx, &wy, &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll})
       v->resize(n);
+    for (auto& v : history.fresh) v.resize(n);
     pair.resize(n);
     coeff.resize(n);
   }
   void copy(std::size_t to, std::size_t from) {
-    for (auto* v : {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &xi_old, &mr_old})
-      (*v)[to] = (*v)[from];
+    for (auto* v : inputs()) (*v)[to] = (*v)[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];
+  }
+
+ private:
+  // What phase B reads (copied into the padding lanes).
+  std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
+    return {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel,
+            &history.old[0], &history.old[1], &history.old[2], &history.old[3]};
   }
 };
 

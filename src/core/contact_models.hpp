@@ -1,6 +1,18 @@
-// Contact laws (physics.md sections 2-3). Each law is a small value type with one static
-// `evaluate`; the pair loop (core/forces.hpp) is written once and instantiated per
-// (law, rolling model) at setup, so a scene pays only for the models it uses.
+// Contact sub-models (physics.md sections 2-3), in three slots (style.md item 5):
+//   law      normal and tangential force: HertzMindlin, ThesisModel, LinearModel;
+//   rolling  rolling resistance: RollingNone, RollingConstant, RollingEpsd;
+//   tracker  what a contact records for other models: TrackNone, TrackPeakEnergy.
+// Each sub-model is a small value type that owns
+//   - its coefficients: `Coeffs<V>` (V = double for one material pair, Pack for one pair per
+//     lane), made from the pair's mixed material properties by `coeffs(MaterialPair)`, with
+//     `tie()` listing the members once (the kernel gathers packs through it);
+//   - its history: `kHistory`, the slots it carries from step to step (name, unit, meaning);
+//     `History<T>` holds them. The contact's history is law + rolling + tracker slots, and the
+//     neighbour lists, migration and (later) checkpoints size themselves from it;
+//   - one static `evaluate`.
+// ContactModel<Law, Rolling, Tracker> composes them; the pair and wall paths of the force
+// kernel (contact_engine.cpp) call its one `evaluate`. The combination is chosen once at setup
+// (make_contact_kernel), so a scene pays only for the models it uses.
 //
 // Kinematics of one contact (sphere i, body j), lower id first:
 //   n from i to j, t = perp(n) = (-n_y, n_x), overlap delta = r_i + r_j - |x_j - x_i| > 0,
@@ -18,8 +30,11 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <tuple>
 
+#include "core/contact_history.hpp"
 #include "core/materials.hpp"
 #include "core/simd.hpp"
 
@@ -37,13 +52,10 @@ struct KinematicsT {
 };
 using ContactKinematics = KinematicsT<double>;
 
-// State a contact carries from step to step; created at first touch, deleted when it ends.
-template <class T>
-struct HistoryT {
-  T xi = T(0.0);      // tangential spring elongation, m (2D: one scalar)
-  T m_roll = T(0.0);  // epsd rolling spring torque, N m
-};
-using ContactHistory = HistoryT<double>;
+// A sub-model's history values for one contact (or one per lane): created zero at first
+// touch, deleted when the contact ends.
+template <class T, std::size_t N>
+using HistoryArray = std::array<T, N>;
 
 template <class T>
 struct ContactForceT {
@@ -53,6 +65,7 @@ struct ContactForceT {
   T k_rate = T(0.0);      // 1/s, d(ln k_n)/dt: Hertz stiffness ~ sqrt(delta) -> v_n / (2 delta)
   T dissipated = T(0.0);  // J in this step
   T elastic = T(0.0);     // J stored (normal + tangential springs)
+  T strain = T(0.0);      // J, the normal elastic energy the breakage law reads (physics.md 5)
 };
 using ContactForce = ContactForceT<double>;
 
@@ -64,30 +77,28 @@ struct RollingTorqueT {
 };
 using RollingTorque = RollingTorqueT<double>;
 
-// The coefficients of PairCoeffs that the laws read, one per lane of a pack.
-struct CoeffPack {
-  Pack e_star, g_star, mu_s, mu_r, damp, tangential_ratio, zeta_n, zeta_t, kn_const,
-      kn_per_radius, gamma_linear;
-  CoeffPack() = default;
-  explicit CoeffPack(const PairCoeffs& c)
-      : e_star(c.e_star), g_star(c.g_star), mu_s(c.mu_s), mu_r(c.mu_r), damp(c.damp),
-        tangential_ratio(c.tangential_ratio), zeta_n(c.zeta_n), zeta_t(c.zeta_t),
-        kn_const(c.kn_const), kn_per_radius(c.kn_per_radius), gamma_linear(c.gamma_linear) {}
-  // Lane l takes table[index(l)].
-  template <class Index>
-  CoeffPack(const PairCoeffs* table, Index index)
-      : e_star([&](auto l) { return table[index(l)].e_star; }),
-        g_star([&](auto l) { return table[index(l)].g_star; }),
-        mu_s([&](auto l) { return table[index(l)].mu_s; }),
-        mu_r([&](auto l) { return table[index(l)].mu_r; }),
-        damp([&](auto l) { return table[index(l)].damp; }),
-        tangential_ratio([&](auto l) { return table[index(l)].tangential_ratio; }),
-        zeta_n([&](auto l) { return table[index(l)].zeta_n; }),
-        zeta_t([&](auto l) { return table[index(l)].zeta_t; }),
-        kn_const([&](auto l) { return table[index(l)].kn_const; }),
-        kn_per_radius([&](auto l) { return table[index(l)].kn_per_radius; }),
-        gamma_linear([&](auto l) { return table[index(l)].gamma_linear; }) {}
-};
+// Coefficients of one lane each: lane l takes at(l) (a Coeffs<double>), member by member
+// through `tie()`.
+template <template <class> class Coeffs, class At>
+[[gnu::always_inline]] inline Coeffs<Pack> gather_coeffs(At at) {
+  Coeffs<Pack> out;
+  auto dst = Coeffs<Pack>::tie(out);
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    ((std::get<I>(dst) = Pack([&](auto l) { return std::get<I>(Coeffs<double>::tie(at(l))); })), ...);
+  }(std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
+  return out;
+}
+// The same coefficients in every lane.
+template <template <class> class Coeffs>
+inline Coeffs<Pack> broadcast_coeffs(const Coeffs<double>& c) {
+  Coeffs<Pack> out;
+  auto dst = Coeffs<Pack>::tie(out);
+  const auto src = Coeffs<double>::tie(c);
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    ((std::get<I>(dst) = Pack(std::get<I>(src))), ...);
+  }(std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
+  return out;
+}
 
 inline double sign(double x) { return vsign(x); }
 
@@ -103,7 +114,7 @@ inline double sign(double x) { return vsign(x); }
 // energy balance closes; `k_rate` is d(ln k)/dt (0 for a constant stiffness).
 template <class T, class M>
 [[gnu::always_inline]] inline void tangential_spring(T k_t, T k_rate, T c_t, M mu_s, T f_n, T v_t,
-                                                     double dt, T xi_old, HistoryT<T>& h,
+                                                     double dt, T xi_old, T& xi_new,
                                                      ContactForceT<T>& out) {
   out.dissipated = out.dissipated - 0.5 * k_t * xi_old * xi_old * k_rate * dt;
   const T xi = xi_old + v_t * dt;
@@ -115,20 +126,43 @@ template <class T, class M>
   const T slide = -f_t_capped * v_t * dt - 0.5 * k_t * (xi_capped * xi_capped - xi_old * xi_old);
   const T stick = c_t * v_t * v_t * dt;
   out.dissipated = out.dissipated + select(capped, slide, stick);
-  h.xi = select(capped, xi_capped, xi);
+  xi_new = select(capped, xi_capped, xi);
   out.f_t = select(capped, f_t_capped, f_t);
-  out.elastic = out.elastic + 0.5 * k_t * h.xi * h.xi;
+  out.elastic = out.elastic + 0.5 * k_t * xi_new * xi_new;
 }
+
+// The tangential spring's one history slot (hertz-mindlin, linear).
+inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
+    {{"xi", "m", "tangential spring elongation"}}};
+
+// ---------------------------------------------------------------------------------------------
+// Laws
 
 // Hertz-Mindlin "no-slip" (seed 004, EDEM):
 //   S_n = 2 E* sqrt(R* delta), F_n = 4/3 E* sqrt(R*) delta^1.5 - 2 sqrt(5/6) beta sqrt(S_n m*) v_n,
 //   S_t = 8 G* sqrt(R* delta), F_t = -S_t xi - 2 sqrt(5/6) beta sqrt(S_t m*) v_t, |F_t| <= mu_s F_n,
 //   beta mapped from the restitution asked for the clamped law (materials.hpp).
+// Strain energy (breakage): the Hertz energy 8/15 E* sqrt(R*) delta^2.5.
 struct HertzMindlin {
   static constexpr bool kTorqueArmIsReff = false;
+  static constexpr auto kHistory = kTangentialSpringHistory;
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class V>
+  struct Coeffs {
+    V e_star{}, g_star{}, mu_s{};
+    V damp{};              // -2 sqrt(5/6) beta >= 0
+    V tangential_ratio{};  // sqrt(S_t / S_n) = sqrt(4 G* / E*)
+    template <class S>
+    static auto tie(S& c) { return std::tie(c.e_star, c.g_star, c.mu_s, c.damp, c.tangential_ratio); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair& m) {
+    return {m.e_star, m.g_star, m.mu_s, -2.0 * std::sqrt(5.0 / 6.0) * hertz_beta_for_restitution(m.restitution),
+            std::sqrt(4.0 * m.g_star / m.e_star)};
+  }
   template <class T, class C>
   [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                          const HistoryT<T>& old, HistoryT<T>& h,
+                                                          const History<T>& old, History<T>& h,
                                                           double dt) {
     ContactForceT<T> out;
     const T s = vsqrt(k.r_eff * k.delta);
@@ -140,10 +174,11 @@ struct HertzMindlin {
     out.k_n = s_n;
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.4 * f_el * k.delta;  // 8/15 E* sqrt(R*) delta^2.5
+    out.strain = out.elastic;
     out.k_rate = 0.5 * k.v_n / k.delta;  // d ln sqrt(delta) / dt, with d(delta)/dt = v_n
     const T s_t = 8.0 * c.g_star * s;
     tangential_spring(s_t, out.k_rate, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t, dt,
-                      old.xi, h, out);
+                      old[0], h[0], out);
     return out;
   }
 };
@@ -151,13 +186,23 @@ struct HertzMindlin {
 // The thesis's law as written (T9-T23): Hertz stiffness k_n = 4/3 E* sqrt(R* delta) (T11),
 // viscous normal damping c_n = 2 zeta_n sqrt(m* S_n) (T22), pure Coulomb sliding
 // F_s = mu_s F_n sign(v_t) (T13) plus tangential damping c_t = 4 zeta_t sqrt(m* 2 G* sqrt(R* delta))
-// (T23), torques with the arm R* (T15). Normal force clamped at zero like the others.
+// (T23), torques with the arm R* (T15). Normal force clamped at zero like the others. No
+// history. Strain energy (breakage): k_n delta^2 / 2 (T35).
 struct ThesisModel {
   static constexpr bool kTorqueArmIsReff = true;
+  static constexpr std::array<HistorySlot, 0> kHistory{};
+  template <class T>
+  using History = HistoryArray<T, 0>;
+  template <class V>
+  struct Coeffs {
+    V e_star{}, g_star{}, mu_s{}, zeta_n{}, zeta_t{};
+    template <class S>
+    static auto tie(S& c) { return std::tie(c.e_star, c.g_star, c.mu_s, c.zeta_n, c.zeta_t); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair& m) { return {m.e_star, m.g_star, m.mu_s, m.zeta_n, m.zeta_t}; }
   template <class T, class C>
   [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                          const HistoryT<T>&, HistoryT<T>& h,
-                                                          double dt) {
+                                                          const History<T>&, History<T>&, double dt) {
     ContactForceT<T> out;
     const T s = vsqrt(k.r_eff * k.delta);
     const T s_n = 2.0 * c.e_star * s;
@@ -166,13 +211,13 @@ struct ThesisModel {
     const T f_n = vmax(T(0.0), f_el + c_n * k.v_n);
     const T c_t = 4.0 * c.zeta_t * vsqrt(k.m_eff * 2.0 * c.g_star * s);
     const T f_t = -c.mu_s * f_n * vsign(k.v_t) - c_t * k.v_t;
-    h.xi = T(0.0);
     out.f_n = f_n;
     out.f_t = f_t;
     out.k_n = s_n;
     out.k_rate = 0.5 * k.v_n / k.delta;
     out.dissipated = (f_n - f_el) * k.v_n * dt - f_t * k.v_t * dt;
     out.elastic = 0.4 * f_el * k.delta;
+    out.strain = 0.5 * f_el * k.delta;
     return out;
   }
 };
@@ -180,36 +225,67 @@ struct ThesisModel {
 // Linear spring-dashpot (Cundall & Strack 1979): k_n constant per pair (or 4/3 E* 0.1 R*),
 // c_n = 2 gamma sqrt(k_n m*) with gamma mapped from the restitution for the clamped law,
 // k_t = 2/7 k_n (equal normal and tangential periods for a sphere), c_t = 2 gamma sqrt(k_t m*).
+// Strain energy (breakage): k_n delta^2 / 2.
 struct LinearModel {
   static constexpr bool kTorqueArmIsReff = false;
+  static constexpr auto kHistory = kTangentialSpringHistory;
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class V>
+  struct Coeffs {
+    V mu_s{};
+    V kn_const{}, kn_per_radius{};  // k_n = kn_const + kn_per_radius R*
+    V gamma{};                      // damping ratio
+    template <class S>
+    static auto tie(S& c) { return std::tie(c.mu_s, c.kn_const, c.kn_per_radius, c.gamma); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair& m) {
+    // Without a stiffness for both materials: the Hertz secant stiffness at an overlap of 1 % of
+    // R*, 4/3 E* sqrt(R* 0.01 R*).
+    const bool given = m.normal_stiffness > 0.0;
+    return {m.mu_s, given ? m.normal_stiffness : 0.0, given ? 0.0 : 4.0 / 3.0 * m.e_star * 0.1,
+            linear_gamma_for_restitution(m.restitution)};
+  }
   template <class T, class C>
   [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                          const HistoryT<T>& old, HistoryT<T>& h,
+                                                          const History<T>& old, History<T>& h,
                                                           double dt) {
     ContactForceT<T> out;
     const T k_n = c.kn_const + c.kn_per_radius * k.r_eff;
     const T f_el = k_n * k.delta;
-    const T f_n = vmax(T(0.0), f_el + 2.0 * c.gamma_linear * vsqrt(k_n * k.m_eff) * k.v_n);
+    const T f_n = vmax(T(0.0), f_el + 2.0 * c.gamma * vsqrt(k_n * k.m_eff) * k.v_n);
     out.f_n = f_n;
     out.k_n = k_n;
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.5 * f_el * k.delta;
+    out.strain = out.elastic;
     const T k_t = (2.0 / 7.0) * k_n;
-    tangential_spring(k_t, T(0.0), T(2.0 * c.gamma_linear * vsqrt(k_t * k.m_eff)), c.mu_s, f_n, k.v_t,
-                      dt, old.xi, h, out);
+    tangential_spring(k_t, T(0.0), T(2.0 * c.gamma * vsqrt(k_t * k.m_eff)), c.mu_s, f_n, k.v_t, dt,
+                      old[0], h[0], out);
     return out;
   }
 };
 
-// No rolling resistance: nothing is computed.
+// ---------------------------------------------------------------------------------------------
+// Rolling models
+
+// No rolling resistance: nothing is computed, nothing stored.
 struct RollingNone {
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
+  static constexpr std::array<HistorySlot, 0> kHistory{};
+  template <class T>
+  using History = HistoryArray<T, 0>;
+  template <class V>
+  struct Coeffs {
+    template <class S>
+    static auto tie(S&) { return std::tie(); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair&, double) { return {}; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C&, const KinematicsT<T>&,
-                                                           const ContactForceT<T>&,
-                                                           const HistoryT<T>&, HistoryT<T>&, double,
-                                                           double) {
+                                                           const ContactForceT<T>&, const History<T>&,
+                                                           History<T>&, double) {
     return {};
   }
 };
@@ -218,11 +294,20 @@ struct RollingNone {
 struct RollingConstant {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
+  static constexpr std::array<HistorySlot, 0> kHistory{};
+  template <class T>
+  using History = HistoryArray<T, 0>;
+  template <class V>
+  struct Coeffs {
+    V mu_r{};
+    template <class S>
+    static auto tie(S& c) { return std::tie(c.mu_r); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair& m, double) { return {m.mu_r}; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                           const ContactForceT<T>& cf,
-                                                           const HistoryT<T>&, HistoryT<T>&,
-                                                           double dt, double) {
+                                                           const ContactForceT<T>& cf, const History<T>&,
+                                                           History<T>&, double dt) {
     const T m = -c.mu_r * cf.f_n * k.r_eff * vsign(k.omega_rel);
     return {m, -m * k.omega_rel * dt, T(0.0)};
   }
@@ -232,31 +317,42 @@ struct RollingConstant {
 //   k_r = 2.25 k_n mu_r^2 R*^2, M_k += -k_r w_rel dt, |M_k| <= M_max = mu_r R* F_n,
 //   M_d = -eta_r 2 sqrt(I_r k_r) w_rel while |M_k| < M_max (off at full mobilisation), and
 //   |M_k + M_d| <= M_max: the dashpot cannot push the torque past the cap either.
-// eta_r is `rolling_damping` (ContactSpec), passed in as `eta`. Stiffness change at constant
-// torque (see tangential_spring): U = M^2 / (2 k_r) changes by -U d(ln k_r)/dt dt with no work
-// done; booked as dissipated.
+// eta_r is `contact.rolling_damping`. Stiffness change at constant torque (see
+// tangential_spring): U = M^2 / (2 k_r) changes by -U d(ln k_r)/dt dt with no work done;
+// booked as dissipated.
 struct RollingEpsd {
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
+  static constexpr std::array<HistorySlot, 1> kHistory{{{"m_roll", "N m", "rolling spring torque"}}};
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class V>
+  struct Coeffs {
+    V mu_r{};
+    V eta{};  // rolling dashpot damping ratio eta_r
+    template <class S>
+    static auto tie(S& c) { return std::tie(c.mu_r, c.eta); }
+  };
+  static Coeffs<double> coeffs(const MaterialPair& m, double rolling_damping) { return {m.mu_r, rolling_damping}; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                           const ContactForceT<T>& cf,
-                                                           const HistoryT<T>& old, HistoryT<T>& h,
-                                                           double dt, double eta) {
+                                                           const ContactForceT<T>& cf, const History<T>& old,
+                                                           History<T>& h, double dt) {
     const T k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
     const auto active = k_r > 0.0;  // mu_r = 0: no rolling spring at all
     const T m_max = c.mu_r * k.r_eff * cf.f_n;
-    const T m_k = old.m_roll - k_r * k.omega_rel * dt;
+    const T m_old = old[0];
+    const T m_k = m_old - k_r * k.omega_rel * dt;
     const T half_compliance = 0.5 / k_r;
-    const T stiffness_change = half_compliance * old.m_roll * old.m_roll * cf.k_rate * dt;
-    const T stored_old = old.m_roll * old.m_roll;
+    const T stiffness_change = half_compliance * m_old * m_old * cf.k_rate * dt;
+    const T stored_old = m_old * m_old;
     // Full mobilisation: plastic rolling at the cap, no dashpot.
     const auto full = vabs(m_k) >= m_max;
     const T m_full = vcopysign(m_max, m_k);
     const T diss_full =
         -m_full * k.omega_rel * dt - half_compliance * (m_full * m_full - stored_old) + stiffness_change;
     // Elastic: spring plus dashpot, the sum capped too.
-    const T c_r = eta * 2.0 * vsqrt(k.i_eff * k_r);
+    const T c_r = c.eta * 2.0 * vsqrt(k.i_eff * k_r);
     const T m = m_k - c_r * k.omega_rel;
     const auto over = vabs(m) > m_max;
     const T m_capped = vcopysign(m_max, m);
@@ -264,11 +360,103 @@ struct RollingEpsd {
         -m_capped * k.omega_rel * dt - half_compliance * (m_k * m_k - stored_old) + stiffness_change;
     const T diss_free = c_r * k.omega_rel * k.omega_rel * dt + stiffness_change;
     const T spring = select(full, m_full, m_k);
-    h.m_roll = select(active, spring, T(0.0));
+    h[0] = select(active, spring, T(0.0));
     RollingTorqueT<T> out;
     out.torque = select(active, select(full, m_full, select(over, m_capped, m)), T(0.0));
     out.dissipated = select(active, select(full, diss_full, select(over, diss_over, diss_free)), T(0.0));
     out.elastic = select(active, half_compliance * spring * spring, T(0.0));
+    return out;
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Trackers: what a contact records for models outside the force law.
+
+struct TrackNone {
+  static constexpr std::array<HistorySlot, 0> kHistory{};
+  template <class T>
+  using History = HistoryArray<T, 0>;
+  template <class T>
+  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>&, const History<T>&, History<T>&) {}
+};
+
+// The largest strain energy of the contact so far (the breakage test reads it at the peak or
+// end of the contact, physics.md section 5).
+struct TrackPeakEnergy {
+  static constexpr std::array<HistorySlot, 1> kHistory{
+      {{"peak_energy", "J", "largest normal strain energy of the contact so far"}}};
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class T>
+  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>& cf, const History<T>& old, History<T>& h) {
+    h[0] = vmax(old[0], cf.strain);
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// The composed model: one law, one rolling model, one tracker.
+
+template <class T, class Law, class Rolling, class Tracker>
+struct ContactHistoryT {
+  typename Law::template History<T> law{};
+  typename Rolling::template History<T> rolling{};
+  typename Tracker::template History<T> tracker{};
+};
+
+template <class T>
+struct ContactResponseT {
+  ContactForceT<T> law;
+  RollingTorqueT<T> rolling;
+};
+
+template <class LawT, class RollingT, class TrackerT>
+struct ContactModel {
+  using Law = LawT;
+  using Rolling = RollingT;
+  using Tracker = TrackerT;
+  static constexpr std::size_t kLawSlots = Law::kHistory.size();
+  static constexpr std::size_t kRollingSlots = Rolling::kHistory.size();
+  static constexpr std::size_t kHistoryWidth = kLawSlots + kRollingSlots + Tracker::kHistory.size();
+  template <class T>
+  using History = ContactHistoryT<T, Law, Rolling, Tracker>;
+  template <class V>
+  struct Coeffs {
+    typename Law::template Coeffs<V> law;
+    typename Rolling::template Coeffs<V> rolling;
+  };
+
+  // The declared slots, law first, then rolling, then tracker: the order of the values in the
+  // neighbour lists and in HistoryRecords.
+  static std::vector<HistorySlot> history_slots() {
+    std::vector<HistorySlot> out(Law::kHistory.begin(), Law::kHistory.end());
+    out.insert(out.end(), Rolling::kHistory.begin(), Rolling::kHistory.end());
+    out.insert(out.end(), Tracker::kHistory.begin(), Tracker::kHistory.end());
+    return out;
+  }
+  static Coeffs<double> coeffs(const MaterialPair& m, const ContactSpec& spec) {
+    return {Law::coeffs(m), Rolling::coeffs(m, spec.rolling_damping)};
+  }
+  template <class Index>
+  [[gnu::always_inline]] static Coeffs<Pack> gather(const Coeffs<double>* table, Index index) {
+    using LawC = typename Law::template Coeffs<double>;
+    using RollC = typename Rolling::template Coeffs<double>;
+    return {gather_coeffs<Law::template Coeffs>([&](auto l) -> const LawC& { return table[index(l)].law; }),
+            gather_coeffs<Rolling::template Coeffs>([&](auto l) -> const RollC& { return table[index(l)].rolling; })};
+  }
+  static Coeffs<Pack> broadcast(const Coeffs<double>& c) {
+    return {broadcast_coeffs<Law::template Coeffs>(c.law), broadcast_coeffs<Rolling::template Coeffs>(c.rolling)};
+  }
+
+  // One contact (or one per lane): the law, then the rolling model on the law's normal force,
+  // then the tracker on both. Shared by particle-particle and particle-wall contacts.
+  template <class T, class C>
+  [[gnu::always_inline]] static ContactResponseT<T> evaluate(const C& c, const KinematicsT<T>& kin,
+                                                             const History<T>& old, History<T>& h,
+                                                             double dt) {
+    ContactResponseT<T> out;
+    out.law = Law::evaluate(c.law, kin, old.law, h.law, dt);
+    if constexpr (Rolling::kActive) out.rolling = Rolling::evaluate(c.rolling, kin, out.law, old.rolling, h.rolling, dt);
+    Tracker::evaluate(out.law, old.tracker, h.tracker);
     return out;
   }
 };

@@ -110,7 +110,7 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
       }
       const InteractionSpec none;
       const InteractionSpec& in = inter ? *inter : none;
-      PairCoeffs c;
+      MaterialPair c;
       const double nu_a = ma.poisson_ratio, nu_b = mb.poisson_ratio;
       c.e_star = 1.0 / ((1 - nu_a * nu_a) / ma.youngs_modulus + (1 - nu_b * nu_b) / mb.youngs_modulus);
       c.g_star = 1.0 / (2 * (2 - nu_a) * (1 + nu_a) / ma.youngs_modulus +
@@ -120,18 +120,8 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
       c.mu_r = mean_or(in.rolling_friction, ma.rolling_friction, mb.rolling_friction);
       c.zeta_n = mean_or(in.damping_normal, ma.damping_normal, mb.damping_normal);
       c.zeta_t = mean_or(in.damping_tangential, ma.damping_tangential, mb.damping_tangential);
-      // Only the map of the law in use is computed (each costs tens of milliseconds).
-      if (scene.contact.model == ContactModelKind::kHertzMindlin)
-        c.damp = -2.0 * std::sqrt(5.0 / 6.0) * hertz_beta_for_restitution(c.restitution);
-      c.tangential_ratio = std::sqrt(4.0 * c.g_star / c.e_star);
-      if (ma.normal_stiffness > 0 && mb.normal_stiffness > 0) {
-        c.kn_const = 0.5 * (ma.normal_stiffness + mb.normal_stiffness);
-      } else {
-        // Hertz secant stiffness at an overlap of 1 % of R*: 4/3 E* sqrt(R* 0.01 R*).
-        c.kn_per_radius = 4.0 / 3.0 * c.e_star * 0.1;
-      }
-      if (scene.contact.model == ContactModelKind::kLinear)
-        c.gamma_linear = linear_gamma_for_restitution(c.restitution);
+      if (ma.normal_stiffness > 0 && mb.normal_stiffness > 0)
+        c.normal_stiffness = 0.5 * (ma.normal_stiffness + mb.normal_stiffness);
       table_[a * n_ + b] = c;
     }
   }

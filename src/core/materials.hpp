@@ -1,4 +1,4 @@
-// PairTable: contact coefficients for every ordered pair of materials, computed once.
+// PairTable: the mixed properties of every ordered pair of materials, computed once.
 //
 // Effective moduli (physics.md section 2):
 //   1/E* = (1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j
@@ -13,36 +13,29 @@
 
 namespace dem2d {
 
-struct PairCoeffs {
-  double e_star = 0.0;         // Pa
-  double g_star = 0.0;         // Pa
-  double restitution = 1.0;    // asked
-  double mu_s = 0.0;           // sliding friction
-  double mu_r = 0.0;           // rolling friction
-  // hertz-mindlin: F_d = -2 sqrt(5/6) beta sqrt(S m*) v; stored as damp = -2 sqrt(5/6) beta >= 0,
-  // with beta mapped from the restitution asked so that the clamped law gives it back.
-  double damp = 0.0;
-  double tangential_ratio = 0.0;  // sqrt(S_t / S_n) = sqrt(4 G* / E*)
-  // thesis: zeta_n, zeta_t (T22, T23)
-  double zeta_n = 0.0;
+// The mixed properties of one ordered pair of materials: what every contact law builds its own
+// coefficients from (contact_models.hpp, `Law::coeffs`).
+struct MaterialPair {
+  double e_star = 0.0;            // Pa
+  double g_star = 0.0;            // Pa
+  double restitution = 1.0;       // asked (hertz-mindlin, linear)
+  double mu_s = 0.0;              // sliding friction
+  double mu_r = 0.0;              // rolling friction
+  double zeta_n = 0.0;            // thesis: damping ratios (T22, T23)
   double zeta_t = 0.0;
-  // linear: k_n = kn_const + kn_per_radius R*, c_n = 2 gamma sqrt(k_n m*), k_t = 2/7 k_n
-  double kn_const = 0.0;
-  double kn_per_radius = 0.0;
-  double gamma_linear = 0.0;
+  double normal_stiffness = 0.0;  // linear: mean k_n of the two materials, N/m (0: from E*)
 };
 
 class PairTable {
  public:
   PairTable() = default;
   PairTable(const Scene& scene);
-  const PairCoeffs& operator()(int a, int b) const { return table_[a * n_ + b]; }
+  const MaterialPair& operator()(int a, int b) const { return table_[a * n_ + b]; }
   int n_materials() const { return n_; }
-  const PairCoeffs* data() const { return table_.data(); }  // [a * n_materials() + b]
 
  private:
   int n_ = 0;
-  std::vector<PairCoeffs> table_;
+  std::vector<MaterialPair> table_;
 };
 
 // Damping factor beta (<= 0) of the hertz-mindlin law (force clamped at zero) that gives the

@@ -9,16 +9,18 @@ namespace dem2d {
 
 namespace {
 
-// Carry histories from `old` (sorted keys) to `fresh` (sorted keys) by key equality.
+// Carry histories (`width` values per contact) from `old` (sorted keys) to `fresh` (sorted
+// keys) by key equality; new contacts start at zero.
 template <class KeyOld, class KeyNew>
-void merge_history(std::size_t n_old, KeyOld key_old, const Array<ContactHistory>& hist_old,
-                   std::size_t n_new, KeyNew key_new, Array<ContactHistory>& hist_new) {
-  hist_new.assign(n_new, ContactHistory{});
+void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old, const Array<double>& hist_old,
+                   std::size_t n_new, KeyNew key_new, Array<double>& hist_new) {
+  hist_new.assign(n_new * width, 0.0);
+  if (width == 0) return;
   std::size_t a = 0;
   for (std::size_t b = 0; b < n_new && a < n_old; ++b) {
     const auto kb = key_new(b);
     while (a < n_old && key_old(a) < kb) ++a;
-    if (a < n_old && key_old(a) == kb) hist_new[b] = hist_old[a];
+    if (a < n_old && key_old(a) == kb) std::copy_n(&hist_old[a * width], width, &hist_new[b * width]);
   }
 }
 
@@ -40,6 +42,7 @@ void NeighborSearch::build(const ParticleStore& p, const Walls& walls, double sk
 void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, PairList& out) {
   const std::size_t n = p.size();
   PairList fresh;
+  fresh.width = out.width;
   if (n == 0) {
     out = std::move(fresh);
     return;
@@ -112,7 +115,7 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
     }
   }
   merge_history(
-      out.size(), [&](std::size_t k) { return std::pair{out.id_i[k], out.id_j[k]}; }, out.history,
+      out.width, out.size(), [&](std::size_t k) { return std::pair{out.id_i[k], out.id_j[k]}; }, out.history,
       fresh.size(), [&](std::size_t k) { return std::pair{fresh.id_i[k], fresh.id_j[k]}; },
       fresh.history);
   fresh.trial = fresh.history;
@@ -122,6 +125,7 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
 void NeighborSearch::build_wall_pairs(const ParticleStore& p, const Walls& walls, double skin,
                                       WallPairList& out) {
   WallPairList fresh;
+  fresh.width = out.width;
   const auto& elements = walls.elements();
   const int n_el = static_cast<int>(elements.size());
   // Closest approach of any drum segment to the drum centre: particles well inside skip them.
@@ -154,7 +158,7 @@ void NeighborSearch::build_wall_pairs(const ParticleStore& p, const Walls& walls
     }
   }
   merge_history(
-      out.size(), [&](std::size_t k) { return std::pair{out.id[k], out.element[k]}; }, out.history,
+      out.width, out.size(), [&](std::size_t k) { return std::pair{out.id[k], out.element[k]}; }, out.history,
       fresh.size(), [&](std::size_t k) { return std::pair{fresh.id[k], fresh.element[k]}; },
       fresh.history);
   fresh.trial = fresh.history;

@@ -5,14 +5,14 @@
 // Canonical order (architecture.md, Reproducibility): every pair is stored lower id first and
 // the list is sorted by (id_i, id_j). Scattering pair forces in that order adds the forces on
 // each particle in the order of its partners' ids, whatever the storage order or rank count.
-// Contact history lives beside the list and is carried to the new list at each rebuild by
-// matching (id_i, id_j) keys (both lists are sorted, so this is one merge).
+// Contact history lives beside the list, `width` values per listed contact (the slots the
+// contact model declares, core/contact_history.hpp), and is carried to the new list at each
+// rebuild by matching (id_i, id_j) keys (both lists are sorted, so this is one merge).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
-#include "core/contact_models.hpp"
 #include "core/particles.hpp"
 #include "core/walls.hpp"
 
@@ -21,17 +21,21 @@ namespace dem2d {
 struct PairList {
   Array<std::int32_t> i, j;        // local indices
   Array<std::int64_t> id_i, id_j;  // keys, id_i < id_j
-  Array<ContactHistory> history;   // committed at the end of each step
-  Array<ContactHistory> trial;     // written by each force evaluation
+  std::size_t width = 0;           // history values per contact
+  Array<double> history;           // committed at the end of each step: [k * width, (k + 1) * width)
+  Array<double> trial;             // written by each force evaluation
   std::size_t size() const { return i.size(); }
+  const double* history_of(std::size_t k) const { return history.data() + k * width; }
 };
 
 struct WallPairList {
   Array<std::int32_t> particle, element;
-  Array<std::int64_t> id;        // particle id (key with element)
-  Array<ContactHistory> history;
-  Array<ContactHistory> trial;
+  Array<std::int64_t> id;          // particle id (key with element)
+  std::size_t width = 0;
+  Array<double> history;
+  Array<double> trial;
   std::size_t size() const { return particle.size(); }
+  const double* history_of(std::size_t k) const { return history.data() + k * width; }
 };
 
 class NeighborSearch {

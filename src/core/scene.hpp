@@ -53,7 +53,7 @@ struct RunSpec {
   int max_passes = 20;             // iterative
   std::uint64_t seed = 1;
   Vec2 gravity{0.0, -9.81};
-  double skin = -1.0;              // m, Verlet skin; < 0: 0.1 of the smallest diameter... set by core
+  double skin = -1.0;              // m, Verlet skin; < 0: 0.4 of the smallest radius (core)
   double dt_safety = 0.2;          // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
   bool allow_unsafe_dt = false;    // run anyway (with a warning) when dt exceeds the safe bound
   int sectors_per_rank = 32;       // parallel runs: angular sectors per rank (METIS groups them)
@@ -64,6 +64,9 @@ struct ContactSpec {
   ContactModelKind model = ContactModelKind::kHertzMindlin;
   RollingModelKind rolling = RollingModelKind::kEpsd;
   double rolling_damping = 0.3;    // epsd: eta_r, the rolling dashpot's damping ratio
+  // Tracker slot: every contact records its peak strain energy (a history slot). Not a deck
+  // key: set by the models that read it (breakage, not yet built) and by tests.
+  bool track_peak_energy = false;
 };
 
 struct LifterSpec {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/contact_models.hpp"
 #include "core/errors.hpp"
 #include "core/fill.hpp"
 #include "core/materials.hpp"
@@ -237,7 +238,7 @@ TEST(PairCoefficients, InteractionOverridesTheMeanCoefficientByCoefficient) {
   EXPECT_DOUBLE_EQ(t(1, 2).mu_s, 0.5);
   EXPECT_DOUBLE_EQ(t(2, 2).mu_s, 0.4);
   // The damping maps the pair's restitution (0.3), not the materials' (0.5).
-  EXPECT_NEAR(restitution_hertz_clamped(-t(0, 1).damp / (2.0 * std::sqrt(5.0 / 6.0))), 0.3, 1e-6);
+  EXPECT_NEAR(restitution_hertz_clamped(-HertzMindlin::coeffs(t(0, 1)).damp / (2.0 * std::sqrt(5.0 / 6.0))), 0.3, 1e-6);
 }
 
 }  // namespace

@@ -1,0 +1,95 @@
+// ContactEngine: every contact of the particle system, and the forces they give.
+//
+// It owns the neighbour lists (core/neighbors.hpp) with the contact histories beside them, the
+// contact model chosen once from the scene (law x rolling model x tracker,
+// core/contact_models.hpp) with its coefficient table, and the batches the kernel works in.
+// For a given state it computes forces, torques, the energies the contacts store and dissipate,
+// and the torque and power of the drive (evaluate); it does not move particles.
+//
+// Histories: each listed contact carries the slots its model declares (history_slots()); a
+// force evaluation writes the advanced values into trial slots, commit() makes them the
+// committed ones at the end of a step. records() and adopt() key them by particle ids so that
+// they travel with their particles (migration) and survive list rebuilds.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "core/contact_history.hpp"
+#include "core/materials.hpp"
+#include "core/neighbors.hpp"
+#include "core/particles.hpp"
+#include "core/scene.hpp"
+#include "core/walls.hpp"
+
+namespace dem2d {
+
+// A run is unstable when an overlap exceeds this fraction of the smaller radius.
+inline constexpr double kMaxOverlapRatio = 0.25;
+
+// What one force evaluation adds up on this rank.
+struct EvaluationTotals {
+  std::int64_t contacts = 0;
+  double dissipated = 0.0;   // J in this step
+  double elastic = 0.0;      // J stored in all contacts
+  double drum_torque = 0.0;  // N m applied by the drive
+  double drive_power = 0.0;  // W delivered by moving walls
+  double max_overlap = 0.0;  // largest delta / min(r_i, r_j)
+  std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)
+};
+
+// The force loop for one contact model, instantiated at setup (contact_engine.cpp).
+class ContactKernel {
+ public:
+  virtual ~ContactKernel() = default;
+  virtual std::span<const HistorySlot> history_slots() const = 0;
+  // Forces and torques of the listed contacts added to p.force and p.torque; trial histories
+  // written; totals of this rank.
+  virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs, WallPairList& wall_pairs,
+                        double dt, EvaluationTotals& totals) = 0;
+};
+std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table);
+
+class ContactEngine {
+ public:
+  explicit ContactEngine(const Scene& scene);
+
+  // The history slots every contact carries (law, then rolling model, then tracker).
+  std::span<const HistorySlot> history_slots() const { return kernel_->history_slots(); }
+  const PairTable& materials() const { return table_; }
+
+  // Rebuild the lists for the particles' current positions (owned and ghosts) and the walls'
+  // current pose, within `skin`; histories of contacts still listed are kept.
+  void build(const ParticleStore& p, const Walls& walls, double skin);
+  // Forces of every listed contact for the current state; histories advanced by dt into the
+  // trial slots (dt = 0: at rest in time). The force accumulators are added to, not cleared.
+  void evaluate(ParticleStore& p, const Walls& walls, double dt);
+  const EvaluationTotals& totals() const { return totals_; }
+  // The trial histories become the committed ones.
+  void commit();
+
+  // Committed histories that are not all zero, keyed by particle ids, sorted.
+  HistoryRecords records() const;
+  // Lists reduced to these keyed histories: the next build() carries them by key.
+  void adopt(const HistoryRecords& records);
+  // The work of each owned particle for load balancing: 1 + its share of the listed pairs
+  // (half of a pair between two owned particles, all of a pair with a ghost). Multiples of 1/2,
+  // so sums of them are exact in any order.
+  std::vector<double> particle_work(std::size_t n_owned) const;
+
+  const PairList& pairs() const { return pairs_; }
+  const WallPairList& wall_pairs() const { return wall_pairs_; }
+  std::int64_t builds() const { return search_.builds(); }
+
+ private:
+  PairTable table_;
+  std::unique_ptr<ContactKernel> kernel_;
+  NeighborSearch search_;
+  PairList pairs_;
+  WallPairList wall_pairs_;
+  EvaluationTotals totals_;
+};
+
+}  // namespace dem2d

@@ -1,0 +1,249 @@
+#include "core/integrators.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dem2d {
+
+// ---------------------------------------------------------------------------------------------
+// Rebuild decision
+
+void RebuildMonitor::record(const ParticleStore& p, const Walls& walls, double time) {
+  pos_at_build_.assign(p.pos.data(), p.pos.data() + p.n_owned());
+  drum_angle_at_build_ = walls.drum_angle();
+  time_at_build_ = time;
+}
+
+bool RebuildMonitor::due(double displacement, const Walls& walls, double time, double ahead) const {
+  const double wall_move = walls.rotating_reach() * (std::abs(walls.drum_angle() - drum_angle_at_build_) +
+                                                     std::abs(walls.drum_speed()) * ahead) +
+                           walls.max_translation_speed() * (time + ahead - time_at_build_);
+  return 2.0 * displacement + wall_move >= skin_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Shared pieces
+
+std::unique_ptr<Integrator> make_integrator(const RunSpec& run, double dt, Vec2 gravity) {
+  if (run.integrator == IntegratorKind::kIterative)
+    return std::make_unique<IterativeIntegrator>(dt, gravity, run.tolerance, std::max(1, run.max_passes));
+  return std::make_unique<VelocityVerlet>(dt, gravity);
+}
+
+double accelerations(ParticleStore& p, Vec2 gravity) {
+  const std::size_t n = p.n_owned();
+  Vec2* a = p.acc.data();
+  double* al = p.alpha.data();
+  const Vec2* f = p.force.data();
+  const double* tq = p.torque.data();
+  const double* inv_m = p.inv_mass.data();
+  const double* inv_i = p.inv_inertia.data();
+  double checksum = 0.0;
+#pragma omp simd reduction(+ : checksum)
+  for (std::size_t k = 0; k < n; ++k) {
+    a[k] = inv_m[k] * f[k] + gravity;
+    al[k] = inv_i[k] * tq[k];
+    checksum += (a[k].x + a[k].y) + al[k];
+  }
+  return checksum;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Velocity Verlet
+
+StepOutcome VelocityVerlet::step(StepStages& s) {
+  ParticleStore& p = s.particles();
+  kick_drift_owned(p);  // v += a dt/2, x += v dt; force accumulators cleared
+  s.advance_clock();
+  if (rebuild_next_)  // decided in the previous step's round
+    s.rebuild();
+  else if (!ghosts_ahead_)
+    s.refresh_ghosts();
+  ghosts_ahead_ = false;
+  s.contact_forces(dt_, /*owned_cleared=*/true);
+  const Closing closing = closing_kick(p, s.rebuilds().positions_at_build());  // v += a dt/2
+  s.commit(dt_);
+  passes_.add(1);
+  return end_of_step_round(s, closing);
+}
+
+void VelocityVerlet::kick_drift_owned(ParticleStore& p) const {
+  const double h = 0.5 * dt_;
+  Vec2* x = p.pos.data();
+  Vec2* v = p.vel.data();
+  const Vec2* a = p.acc.data();
+  double* th = p.theta.data();
+  double* w = p.omega.data();
+  const double* al = p.alpha.data();
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt_);
+    x[k] = d.x;
+    v[k] = d.v;
+    w[k] = d.w;
+    th[k] += dt_ * d.w;
+    f[k] = {};
+    tq[k] = 0.0;
+  }
+}
+
+// The closing half kick fused with the accelerations, and the two maxima of the next step's
+// displacement bound.
+VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec2* x_build) const {
+  const double h = 0.5 * dt_;
+  const std::size_t n = p.n_owned();
+  Vec2* a = p.acc.data();
+  double* al = p.alpha.data();
+  Vec2* v = p.vel.data();
+  double* w = p.omega.data();
+  const Vec2* x = p.pos.data();
+  const Vec2* f = p.force.data();
+  const double* tq = p.torque.data();
+  const double* inv_m = p.inv_mass.data();
+  const double* inv_i = p.inv_inertia.data();
+  const Vec2 g = gravity_;
+  double checksum = 0.0, disp2 = 0.0, speed2 = 0.0;
+#pragma omp simd reduction(+ : checksum) reduction(max : disp2, speed2)
+  for (std::size_t k = 0; k < n; ++k) {
+    a[k] = inv_m[k] * f[k] + g;
+    al[k] = inv_i[k] * tq[k];
+    checksum += (a[k].x + a[k].y) + al[k] + (x[k].x + x[k].y);
+    v[k] += h * a[k];
+    w[k] += h * al[k];
+    const double d2 = norm2(x[k] - x_build[k]);
+    const double s2 = norm2(v[k] + h * a[k]);
+    disp2 = disp2 > d2 ? disp2 : d2;
+    speed2 = speed2 > s2 ? speed2 : s2;
+  }
+  return {checksum, disp2, speed2};
+}
+
+// The step's one collective: stability, and whether the next step rebuilds. The next drift
+// moves a particle by dt |v + a dt/2| (known now), so the displacement since the last build is
+// at most sqrt(max |x - x_build|^2) + dt sqrt(max |v + a dt/2|^2), and the walls move by at most
+// their speed times dt more. In parallel the same round hands the ghosts the state their owners
+// drift them to next, and the next step skips the refresh (wasted when it rebuilds, one step in
+// a hundred or more).
+StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
+  const bool local_ok = std::isfinite(c.checksum) && s.totals().max_overlap <= kMaxOverlapRatio;
+  double reduce[2] = {local_ok ? 0.0 : 1.0, std::sqrt(c.disp2) + dt_ * std::sqrt(c.speed2)};
+  Domain& domain = s.domain();
+  if (domain.size() > 1) {
+    prepare_ghosts_ahead(s.particles(), domain.halo_sources());
+    domain.exchange_step(s.particles(), next_registry_, s.ghost_fields(), reduce);
+    ghosts_ahead_ = true;
+  } else {
+    domain.max(reduce);
+  }
+  if (!std::isfinite(reduce[1])) reduce[0] = 1.0;
+  rebuild_next_ = s.rebuilds().due(reduce[1], s.walls(), s.time(), dt_);
+  return {reduce[0] != 0.0, c.checksum};
+}
+
+void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources) {
+  const double h = 0.5 * dt_;
+  for (const std::int32_t k : sources) {
+    const Drifted d = kick_drift(p.pos[k], p.vel[k], p.acc[k], p.omega[k], p.alpha[k], h, dt_);
+    next_pos_[k] = d.x;
+    next_vel_[k] = d.v;
+    next_omega_[k] = d.w;
+  }
+}
+
+// The next-state fields are sized with the owned set; the new ghosts hold the current state,
+// not the drifted one.
+void VelocityVerlet::after_rebuild(std::size_t n_owned) {
+  for (FieldBase* f : next_registry_) f->resize(n_owned);
+  ghosts_ahead_ = false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The thesis's iterative scheme
+
+StepOutcome IterativeIntegrator::step(StepStages& s) {
+  ParticleStore& p = s.particles();
+  s.advance_clock();
+  if (rebuild_due(s)) s.rebuild();
+  save_start(p);
+  int pass = 0;
+  bool converged = false;
+  double checksum = 0.0;
+  while (pass < max_passes_ && !converged) {
+    predict(p);
+    s.refresh_ghosts();
+    s.contact_forces(dt_, /*owned_cleared=*/false);
+    checksum = accelerations(p, gravity_);
+    ++pass;
+    converged = settled(p, s.domain()) && pass > 1;
+  }
+  predict(p);  // the final state from the last accelerations (p.acc holds a1 for the next step)
+  if (!converged) ++passes_.unconverged_steps;
+  s.commit(dt_);
+  passes_.add(pass);
+  const bool local_ok = std::isfinite(checksum) && s.totals().max_overlap <= kMaxOverlapRatio;
+  return {s.domain().any(!local_ok), checksum};
+}
+
+// The neighbour lists must hold through every pass of this step, and a rebuild (which may
+// migrate particles between ranks) cannot happen between passes: decide it now, from the
+// displacement since the last build plus a bound on this step's motion, |v| dt + |a| dt^2
+// (twice the constant-acceleration travel).
+bool IterativeIntegrator::rebuild_due(StepStages& s) const {
+  const ParticleStore& p = s.particles();
+  const Vec2* x_build = s.rebuilds().positions_at_build();
+  double reach = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    reach = std::max(reach, norm(p.pos[k] - x_build[k]) + norm(p.vel[k]) * dt_ + norm(p.acc[k]) * dt_ * dt_);
+  return s.domain().any(s.rebuilds().due(reach, s.walls(), s.time(), 0.0));
+}
+
+void IterativeIntegrator::save_start(const ParticleStore& p) {
+  const std::size_t n = p.n_owned();
+  x0_.assign(p.pos.data(), p.pos.data() + n);
+  v0_.assign(p.vel.data(), p.vel.data() + n);
+  a0_.assign(p.acc.data(), p.acc.data() + n);
+  th0_.assign(p.theta.data(), p.theta.data() + n);
+  w0_.assign(p.omega.data(), p.omega.data() + n);
+  al0_.assign(p.alpha.data(), p.alpha.data() + n);
+  a1_.assign(a0_.begin(), a0_.end());
+  al1_.assign(al0_.begin(), al0_.end());
+}
+
+void IterativeIntegrator::predict(ParticleStore& p) const {
+  const double dt = dt_, c2 = dt * dt / 6.0;
+  Vec2* x = p.pos.data();
+  Vec2* v = p.vel.data();
+  double* th = p.theta.data();
+  double* w = p.omega.data();
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    x[k] = x0_[k] + dt * v0_[k] + c2 * (2.0 * a0_[k] + a1_[k]);
+    v[k] = v0_[k] + (0.5 * dt) * (a0_[k] + a1_[k]);
+    th[k] = th0_[k] + dt * w0_[k] + c2 * (2.0 * al0_[k] + al1_[k]);
+    w[k] = w0_[k] + (0.5 * dt) * (al0_[k] + al1_[k]);
+  }
+}
+
+// Converged when |a^k - a^(k-1)| <= eps (|a^k| + a_ref) for every DOF (T31) on every rank;
+// angular accelerations are compared in units of a_ref / r. The latest accelerations become a1.
+bool IterativeIntegrator::settled(const ParticleStore& p, Domain& domain) {
+  const double eps = tolerance_;
+  const double a_ref = std::max(norm(gravity_), 1e-12);
+  const std::size_t n = p.n_owned();
+  bool ok = true;
+  for (std::size_t k = 0; k < n && ok; ++k) {
+    const Vec2 a = p.acc[k];
+    const double scale_w = 1.0 / p.radius[k];
+    ok = std::abs(a.x - a1_[k].x) <= eps * (std::abs(a.x) + a_ref) &&
+         std::abs(a.y - a1_[k].y) <= eps * (std::abs(a.y) + a_ref) &&
+         std::abs(p.alpha[k] - al1_[k]) <= eps * (std::abs(p.alpha[k]) + a_ref * scale_w);
+  }
+  ok = !domain.any(!ok);
+  for (std::size_t k = 0; k < n; ++k) {
+    a1_[k] = p.acc[k];
+    al1_[k] = p.alpha[k];
+  }
+  return ok;
+}
+
+}  // namespace dem2d

@@ -1,0 +1,188 @@
+// Time integrators: one type per scheme, each with a step() that names its stages.
+//
+//   VelocityVerlet       kick-drift -> walls -> rebuild or refresh -> contact forces ->
+//                        closing kick -> commit -> end-of-step round
+//   IterativeIntegrator  the thesis's scheme (T3-T8, T26-T33): walls -> rebuild? -> passes of
+//                        (predict -> refresh -> contact forces -> accelerations) until the
+//                        accelerations settle -> final predict -> commit -> end-of-step round
+//
+// An integrator owns its own state (Verlet: the rebuild decision and the ghosts' state computed
+// ahead; iterative: the state at the start of the step) and moves the particles; everything else
+// it asks of the simulation through StepStages. The end-of-step round is the step's one
+// collective decision: stable or not (and, for Verlet, whether the next step rebuilds),
+// identical on every rank.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/contact_engine.hpp"
+#include "core/domain.hpp"
+#include "core/particles.hpp"
+#include "core/scene.hpp"
+#include "core/walls.hpp"
+
+namespace dem2d {
+
+// When the neighbour lists must be rebuilt: two particles approach by at most twice the largest
+// displacement since the last build, and a wall moves by at most rotating_reach * |drum angle
+// change| + translation speed * elapsed time (physics and lists: core/neighbors.hpp).
+class RebuildMonitor {
+ public:
+  explicit RebuildMonitor(double skin = 0.0) : skin_(skin) {}
+  // The state at a build: owned positions, the walls' pose, the time.
+  void record(const ParticleStore& p, const Walls& walls, double time);
+  const Vec2* positions_at_build() const { return pos_at_build_.data(); }
+  // True when particles that moved at most `displacement` since the build, with the walls
+  // `ahead` seconds past `time`, may have come within the skin of a pair not listed.
+  bool due(double displacement, const Walls& walls, double time, double ahead) const;
+  double skin() const { return skin_; }
+
+ private:
+  double skin_;
+  Array<Vec2> pos_at_build_;
+  double drum_angle_at_build_ = 0.0;
+  double time_at_build_ = 0.0;
+};
+
+// The stages of a step that belong to the simulation as a whole (core/simulation.cpp); an
+// integrator calls them in its order.
+class StepStages {
+ public:
+  virtual ParticleStore& particles() = 0;
+  virtual Domain& domain() = 0;
+  virtual const Walls& walls() const = 0;
+  virtual const RebuildMonitor& rebuilds() const = 0;
+  virtual const EvaluationTotals& totals() const = 0;
+  virtual double time() const = 0;
+  // Advance the clock by one step and put the walls where they are then.
+  virtual void advance_clock() = 0;
+  // Migrate, new ghosts, new neighbour lists (called on every rank at the same step).
+  virtual void rebuild() = 0;
+  // Positions, velocities and spins of the ghosts from their owners.
+  virtual void refresh_ghosts() = 0;
+  // The fields refresh_ghosts moves (Verlet hands them ahead at the end of a step).
+  virtual std::span<FieldBase* const> ghost_fields() = 0;
+  // Contact forces and torques at the current state into the accumulators (cleared first, the
+  // owned ones unless `owned_cleared`); histories advanced by dt into the trial slots.
+  virtual void contact_forces(double dt, bool owned_cleared) = 0;
+  // The trial histories become the committed ones; the step's energies are booked.
+  virtual void commit(double dt) = 0;
+
+ protected:
+  ~StepStages() = default;
+};
+
+// The end-of-step round's verdict (the same on every rank) and this rank's checksum of the
+// accelerations (and, Verlet, positions): non-finite when something blew up here.
+struct StepOutcome {
+  bool unstable = false;
+  double checksum = 0.0;
+};
+
+// Passes of force evaluation per step (always 1 for Verlet).
+struct PassCounter {
+  int last = 0;
+  std::int64_t total = 0;
+  std::int64_t since_row = 0, steps_since_row = 0;
+  std::int64_t unconverged_steps = 0;
+  void add(int passes) {
+    last = passes;
+    total += passes;
+    since_row += passes;
+    steps_since_row += 1;
+  }
+  double mean_since_row() const {
+    return steps_since_row > 0 ? static_cast<double>(since_row) / static_cast<double>(steps_since_row)
+                               : static_cast<double>(last);
+  }
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  // Advance the particles by one step of dt, ending with the step's round.
+  virtual StepOutcome step(StepStages& s) = 0;
+  // After every rebuild (the owned set and the ghosts changed), in parallel runs.
+  virtual void after_rebuild(std::size_t /*n_owned*/) {}
+  const PassCounter& passes() const { return passes_; }
+  PassCounter& passes() { return passes_; }
+
+ protected:
+  PassCounter passes_;
+};
+
+std::unique_ptr<Integrator> make_integrator(const RunSpec& run, double dt, Vec2 gravity);
+
+// a = F/m + g and alpha = M/I for the owned particles, gravity added last, the same way for
+// every particle. Returns a checksum (a plain sum: any NaN or infinity makes it non-finite).
+double accelerations(ParticleStore& p, Vec2 gravity);
+
+// Velocity Verlet's opening half kick and drift of one particle. The same operations serve the
+// owned particles and the state a halo source's ghosts are handed ahead, so the bits agree.
+struct Drifted {
+  Vec2 x, v;
+  double w;
+};
+[[gnu::always_inline]] inline Drifted kick_drift(Vec2 x, Vec2 v, Vec2 a, double w, double alpha, double h,
+                                                 double dt) {
+  const Vec2 v_half = v + h * a;
+  return {x + dt * v_half, v_half, w + h * alpha};
+}
+
+// Velocity Verlet (kick-drift-kick); the velocity-dependent forces see the half-step velocity.
+class VelocityVerlet final : public Integrator {
+ public:
+  VelocityVerlet(double dt, Vec2 gravity) : dt_(dt), gravity_(gravity) {}
+  StepOutcome step(StepStages& s) override;
+  void after_rebuild(std::size_t n_owned) override;
+
+ private:
+  struct Closing {
+    double checksum = 0.0;
+    double disp2 = 0.0, speed2 = 0.0;  // max |x - x_build|^2 and |v + a dt/2|^2 (owned)
+  };
+  void kick_drift_owned(ParticleStore& p) const;
+  Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
+  void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
+  StepOutcome end_of_step_round(StepStages& s, const Closing& c);
+
+  double dt_;
+  Vec2 gravity_;
+  bool rebuild_next_ = true;   // decided by the previous step's round
+  bool ghosts_ahead_ = false;  // the ghosts already hold this step's drifted state
+  // In parallel: the state the halo sources will drift to in the next step (their entries
+  // only), sent to the ghosts in the end-of-step round.
+  std::vector<FieldBase*> next_registry_;
+  Field<Vec2> next_pos_{"next_position", next_registry_};
+  Field<Vec2> next_vel_{"next_velocity", next_registry_};
+  Field<double> next_omega_{"next_spin", next_registry_};
+};
+
+// The thesis's iterative refinement: predict the state at t + dt with the jerk
+// b = (a1 - a0)/dt, re-evaluate forces there, repeat until the accelerations stop changing.
+// Converged, this is Newmark's linear-acceleration method:
+//   x1 = x0 + v0 dt + (2 a0 + a1) dt^2 / 6,  v1 = v0 + (a0 + a1) dt / 2.
+class IterativeIntegrator final : public Integrator {
+ public:
+  IterativeIntegrator(double dt, Vec2 gravity, double tolerance, int max_passes)
+      : dt_(dt), gravity_(gravity), tolerance_(tolerance), max_passes_(max_passes) {}
+  StepOutcome step(StepStages& s) override;
+
+ private:
+  bool rebuild_due(StepStages& s) const;
+  void save_start(const ParticleStore& p);
+  void predict(ParticleStore& p) const;
+  bool settled(const ParticleStore& p, Domain& domain);
+
+  double dt_;
+  Vec2 gravity_;
+  double tolerance_;
+  int max_passes_;
+  // The state at the start of the step and the latest accelerations.
+  Array<Vec2> x0_, v0_, a0_, a1_;
+  Array<double> th0_, w0_, al0_, al1_;
+};
+
+}  // namespace dem2d
