@@ -39,14 +39,10 @@ void NeighborSearch::build(const ParticleStore& p, const Walls& walls, double sk
   build_wall_pairs(p, walls, skin, wall_pairs);
 }
 
-void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, PairList& out) {
+// Counting sort of the particles (owned and ghosts) into a grid of cells of side at least the
+// largest reach 2 r_max + skin; sets nx_, ny_, cell_start_, cell_items_, cell_of_.
+void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
   const std::size_t n = p.size();
-  PairList fresh;
-  fresh.width = out.width;
-  if (n == 0) {
-    out = std::move(fresh);
-    return;
-  }
   double r_max = 0.0;
   Vec2 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
   Vec2 hi{-lo.x, -lo.y};
@@ -60,29 +56,36 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
   const double area = std::max(hi.x - lo.x, h) * std::max(hi.y - lo.y, h);
   const double max_cells = 4.0 * static_cast<double>(n) + 1024.0;
   if (area / (h * h) > max_cells) h = std::sqrt(area / max_cells);
-  const int nx = static_cast<int>((hi.x - lo.x) / h) + 1;
-  const int ny = static_cast<int>((hi.y - lo.y) / h) + 1;
+  nx_ = static_cast<int>((hi.x - lo.x) / h) + 1;
+  ny_ = static_cast<int>((hi.y - lo.y) / h) + 1;
   const double inv_h = 1.0 / h;
-
-  // Counting sort of particles into cells.
-  cell_start_.assign(static_cast<std::size_t>(nx) * ny + 1, 0);
+  cell_start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
   cell_of_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    // A non-finite position (a run blowing up: check_stability reports it) goes to cell 0
+    // A non-finite position (a run blowing up: the stability check reports it) goes to cell 0
     // rather than to an undefined cell index.
     const double fx = (p.pos[k].x - lo.x) * inv_h, fy = (p.pos[k].y - lo.y) * inv_h;
-    const int cx = std::isfinite(fx) ? std::min(nx - 1, static_cast<int>(fx)) : 0;
-    const int cy = std::isfinite(fy) ? std::min(ny - 1, static_cast<int>(fy)) : 0;
-    cell_of_[k] = cy * nx + cx;
+    const int cx = std::isfinite(fx) ? std::min(nx_ - 1, static_cast<int>(fx)) : 0;
+    const int cy = std::isfinite(fy) ? std::min(ny_ - 1, static_cast<int>(fy)) : 0;
+    cell_of_[k] = cy * nx_ + cx;
     ++cell_start_[cell_of_[k] + 1];
   }
   std::partial_sum(cell_start_.begin(), cell_start_.end(), cell_start_.begin());
   cell_items_.resize(n);
-  {
-    std::vector<std::int32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
-    for (std::size_t k = 0; k < n; ++k) cell_items_[fill[cell_of_[k]]++] = static_cast<int>(k);
-  }
+  std::vector<std::int32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t k = 0; k < n; ++k) cell_items_[fill[cell_of_[k]]++] = static_cast<int>(k);
+}
 
+void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, PairList& out) {
+  const std::size_t n = p.size();
+  PairList fresh;
+  fresh.width = out.width;
+  if (n == 0) {
+    out = std::move(fresh);
+    return;
+  }
+  bin_particles(p, skin);
+  const int nx = nx_, ny = ny_;
   const std::size_t n_owned = p.n_owned();
   fresh.i.reserve(3 * n);
   fresh.j.reserve(3 * n);

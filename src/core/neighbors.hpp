@@ -52,9 +52,11 @@ class NeighborSearch {
   std::int64_t builds() const { return builds_; }
 
  private:
+  void bin_particles(const ParticleStore& p, double skin);
   void build_particle_pairs(const ParticleStore& p, double skin, PairList& out);
   void build_wall_pairs(const ParticleStore& p, const Walls& walls, double skin, WallPairList& out);
 
+  int nx_ = 0, ny_ = 0;  // cells along x and y at the last build
   Array<std::int32_t> cell_start_, cell_items_, cell_of_, order_, scratch_;
   std::int64_t builds_ = 0;
 };

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "core/contact_models.hpp"
 #include "core/materials.hpp"
@@ -845,6 +846,81 @@ TEST(ContactDirections, BallRollingWithTheShellFeelsNoFrictionOnlyTheRollingCoup
   EXPECT_NEAR(p.force[0].x, 0.0, 1e-9 * f_n);
   EXPECT_NEAR(p.torque[0], m, 1e-9 * std::abs(m));
   EXPECT_NEAR(sim.last_totals().drum_torque, m, 1e-9 * std::abs(m));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model slots (contact_models.hpp): each sub-model declares its history; the contact carries
+// the concatenation. The peak-energy tracker is the slot the breakage model will read.
+
+std::vector<std::string> slot_names(const Simulation& sim) {
+  std::vector<std::string> out;
+  for (const HistorySlot& s : sim.contacts().history_slots()) out.emplace_back(s.name);
+  return out;
+}
+
+// Two steel spheres (r = 0.05 m) meeting head-on at 1 m/s each, e = 1, no friction.
+Scene head_on_scene(bool track_peak_energy) {
+  Scene s = base_scene(ContactModelKind::kHertzMindlin, RollingModelKind::kEpsd, 1.0e-7);
+  s.contact.track_peak_energy = track_peak_energy;
+  s.materials = {steel(1.0, 0.0, 0.1)};
+  s.particles = {ball("steel", 0.05, {-0.0501, 0.0}, {1.0, 0.0}), ball("steel", 0.05, {0.0501, 0.0}, {-1.0, 0.0})};
+  return s;
+}
+
+TEST(ModelSlots, TheDeclaredHistoriesSetTheWidthOfEveryContact) {
+  using Strings = std::vector<std::string>;
+  Scene s = head_on_scene(false);
+  EXPECT_EQ(slot_names(Simulation(s)), (Strings{"xi", "m_roll"}));
+  s.contact.track_peak_energy = true;
+  const Simulation tracked(s);
+  EXPECT_EQ(slot_names(tracked), (Strings{"xi", "m_roll", "peak_energy"}));
+  EXPECT_EQ(tracked.contacts().history_slots()[2].unit, "J");
+  EXPECT_EQ(tracked.pairs().width, 3u);
+  EXPECT_EQ(tracked.contacts().records().width(), 3u) << "migration moves what the models declare";
+  s.contact.model = ContactModelKind::kThesis;
+  s.contact.rolling = RollingModelKind::kNone;
+  s.contact.track_peak_energy = false;
+  const Simulation bare(s);
+  EXPECT_TRUE(slot_names(bare).empty()) << "the thesis law without rolling needs no history";
+  EXPECT_EQ(bare.contacts().records().record_bytes(), 16u) << "a record is its two ids";
+}
+
+// The tracker holds the running maximum of the contact's strain energy, and at the deepest
+// compression of an elastic impact that is the relative kinetic energy 1/2 m* v^2 (all of it
+// stored in the Hertz spring).
+TEST(ModelSlots, PeakEnergyTrackerRecordsTheHertzPeakOfAnImpact) {
+  Simulation sim(head_on_scene(true));
+  const double m = sphere_mass(0.05, 7800.0);
+  const double kinetic = 0.5 * (0.5 * m) * 2.0 * 2.0;
+  double running_max = 0.0, peak = 0.0;
+  bool touched = false, separated = false;
+  for (int k = 0; k < 20000 && !separated; ++k) {
+    sim.step();
+    const bool in_contact = sim.last_totals().contacts > 0;
+    if (in_contact) {
+      touched = true;
+      running_max = std::max(running_max, sim.last_totals().elastic);
+      ASSERT_EQ(sim.pairs().size(), 1u);
+      const double tracked = sim.pairs().history_of(0)[2];
+      EXPECT_EQ(tracked, running_max) << "step " << k << ": the running maximum, bit for bit";
+      peak = tracked;
+    }
+    separated = touched && !in_contact;
+  }
+  ASSERT_TRUE(separated);
+  EXPECT_NEAR(peak, kinetic, 1e-5 * kinetic) << "1/2 m* v^2 = " << kinetic << " J";
+  EXPECT_EQ(sim.pairs().history_of(0)[2], 0.0) << "a contact that ended keeps no history";
+}
+
+TEST(ModelSlots, TheTrackerChangesNoParticleState) {
+  Simulation tracked(head_on_scene(true)), plain(head_on_scene(false));
+  tracked.run_until(4.0e-4);
+  plain.run_until(4.0e-4);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(tracked.particles().pos[k], plain.particles().pos[k]);
+    EXPECT_EQ(tracked.particles().vel[k], plain.particles().vel[k]);
+    EXPECT_EQ(tracked.particles().omega[k], plain.particles().omega[k]);
+  }
 }
 
 }  // namespace

@@ -114,6 +114,7 @@ void check_config(const Config& c) {
 
   NeighborSearch search;
   PairList pairs;
+  pairs.width = 2;  // e.g. a tangential and a rolling spring
   WallPairList wall_pairs;
   search.build(p, walls, c.skin, pairs, wall_pairs);
   const std::vector<IdPair> got = listed_pairs(pairs);
@@ -131,7 +132,7 @@ void check_config(const Config& c) {
     EXPECT_EQ(p.id[pairs.i[k]], pairs.id_i[k]);
     EXPECT_EQ(p.id[pairs.j[k]], pairs.id_j[k]);
   }
-  EXPECT_EQ(pairs.history.size(), pairs.size());
+  EXPECT_EQ(pairs.history.size(), pairs.size() * pairs.width);  // the declared slots per pair
 
   std::vector<IdPair> got_w = listed_wall_pairs(wall_pairs);
   EXPECT_TRUE(std::is_sorted(got_w.begin(), got_w.end()));
