@@ -1,6 +1,8 @@
 #include "core/contact_engine.hpp"
 
 #include <algorithm>
+#include <tuple>
+#include <type_traits>
 
 #include "core/contact_batch.hpp"
 #include "core/contact_models.hpp"
@@ -379,32 +381,29 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
   tot.max_overlap = max_ratio;
 }
 
-// The model is chosen here, once: one kernel per (law, rolling model, tracker).
-template <class Law, class Rolling>
-std::unique_ptr<ContactKernel> with_tracker(const ContactSpec& spec, const PairTable& table) {
-  if (spec.track_peak_energy) return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackPeakEnergy>>>(spec, table);
-  return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackNone>>>(spec, table);
-}
-
-template <class Law>
-std::unique_ptr<ContactKernel> with_rolling(const ContactSpec& spec, const PairTable& table) {
-  switch (spec.rolling) {
-    case RollingModelKind::kNone: return with_tracker<Law, RollingNone>(spec, table);
-    case RollingModelKind::kConstant: return with_tracker<Law, RollingConstant>(spec, table);
-    case RollingModelKind::kEpsd: return with_tracker<Law, RollingEpsd>(spec, table);
-  }
-  return nullptr;
+// The entry of a registry (a std::tuple of models) whose kKind is `kind`, handed to f as
+// std::type_identity<Model>.
+template <class Registry, class Kind, class F>
+std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
+  return [&]<class... Models>(std::type_identity<std::tuple<Models...>>) {
+    std::unique_ptr<ContactKernel> out;
+    ((Models::kKind == kind ? (out = f(std::type_identity<Models>{}), true) : false) || ...);
+    return out;
+  }(std::type_identity<Registry>{});
 }
 
 }  // namespace
 
+// The model is chosen here, once: one kernel per (law, rolling model, tracker).
 std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table) {
-  switch (spec.model) {
-    case ContactModelKind::kHertzMindlin: return with_rolling<HertzMindlin>(spec, table);
-    case ContactModelKind::kThesis: return with_rolling<ThesisModel>(spec, table);
-    case ContactModelKind::kLinear: return with_rolling<LinearModel>(spec, table);
-  }
-  return nullptr;
+  return pick<ContactLaws>(spec.model, [&](auto law) {
+    return pick<RollingModels>(spec.rolling, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
+      using Law = typename decltype(law)::type;
+      using Rolling = typename decltype(rolling)::type;
+      if (spec.track_peak_energy) return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackPeakEnergy>>>(spec, table);
+      return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackNone>>>(spec, table);
+    });
+  });
 }
 
 ContactEngine::ContactEngine(const Scene& scene)

@@ -144,6 +144,7 @@ inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
 //   beta mapped from the restitution asked for the clamped law (materials.hpp).
 // Strain energy (breakage): the Hertz energy 8/15 E* sqrt(R*) delta^2.5.
 struct HertzMindlin {
+  static constexpr ContactModelKind kKind = ContactModelKind::kHertzMindlin;
   static constexpr bool kTorqueArmIsReff = false;
   static constexpr auto kHistory = kTangentialSpringHistory;
   template <class T>
@@ -189,6 +190,7 @@ struct HertzMindlin {
 // (T23), torques with the arm R* (T15). Normal force clamped at zero like the others. No
 // history. Strain energy (breakage): k_n delta^2 / 2 (T35).
 struct ThesisModel {
+  static constexpr ContactModelKind kKind = ContactModelKind::kThesis;
   static constexpr bool kTorqueArmIsReff = true;
   static constexpr std::array<HistorySlot, 0> kHistory{};
   template <class T>
@@ -227,6 +229,7 @@ struct ThesisModel {
 // k_t = 2/7 k_n (equal normal and tangential periods for a sphere), c_t = 2 gamma sqrt(k_t m*).
 // Strain energy (breakage): k_n delta^2 / 2.
 struct LinearModel {
+  static constexpr ContactModelKind kKind = ContactModelKind::kLinear;
   static constexpr bool kTorqueArmIsReff = false;
   static constexpr auto kHistory = kTangentialSpringHistory;
   template <class T>
@@ -240,10 +243,10 @@ struct LinearModel {
     static auto tie(S& c) { return std::tie(c.mu_s, c.kn_const, c.kn_per_radius, c.gamma); }
   };
   static Coeffs<double> coeffs(const MaterialPair& m) {
-    // Without a stiffness for both materials: the Hertz secant stiffness at an overlap of 1 % of
-    // R*, 4/3 E* sqrt(R* 0.01 R*).
-    const bool given = m.normal_stiffness > 0.0;
-    return {m.mu_s, given ? m.normal_stiffness : 0.0, given ? 0.0 : 4.0 / 3.0 * m.e_star * 0.1,
+    // k_n: the mean of the materials' `normal_stiffness` when both give one; otherwise the Hertz
+    // secant stiffness at an overlap of 1 % of R*, 4/3 E* sqrt(R* 0.01 R*).
+    const bool given = m.a.normal_stiffness > 0.0 && m.b.normal_stiffness > 0.0;
+    return {m.mu_s, given ? m.mean(&MaterialSpec::normal_stiffness) : 0.0, given ? 0.0 : 4.0 / 3.0 * m.e_star * 0.1,
             linear_gamma_for_restitution(m.restitution)};
   }
   template <class T, class C>
@@ -271,6 +274,7 @@ struct LinearModel {
 
 // No rolling resistance: nothing is computed, nothing stored.
 struct RollingNone {
+  static constexpr RollingModelKind kKind = RollingModelKind::kNone;
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
   static constexpr std::array<HistorySlot, 0> kHistory{};
@@ -292,6 +296,7 @@ struct RollingNone {
 
 // Constant directional torque (T16; Ai et al. 2011 model A): M = -mu_r F_n R* sign(w_rel).
 struct RollingConstant {
+  static constexpr RollingModelKind kKind = RollingModelKind::kConstant;
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
   static constexpr std::array<HistorySlot, 0> kHistory{};
@@ -321,6 +326,7 @@ struct RollingConstant {
 // tangential_spring): U = M^2 / (2 k_r) changes by -U d(ln k_r)/dt dt with no work done;
 // booked as dissipated.
 struct RollingEpsd {
+  static constexpr RollingModelKind kKind = RollingModelKind::kEpsd;
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
   static constexpr std::array<HistorySlot, 1> kHistory{{{"m_roll", "N m", "rolling spring torque"}}};
@@ -368,6 +374,12 @@ struct RollingEpsd {
     return out;
   }
 };
+
+// ---------------------------------------------------------------------------------------------
+// The registries: the kernel is instantiated for every (law, rolling model) listed here and the
+// scene's pair is picked at setup by kKind (contact_engine.cpp, make_contact_kernel).
+using ContactLaws = std::tuple<HertzMindlin, ThesisModel, LinearModel>;
+using RollingModels = std::tuple<RollingNone, RollingConstant, RollingEpsd>;
 
 // ---------------------------------------------------------------------------------------------
 // Trackers: what a contact records for models outside the force law.

@@ -111,6 +111,8 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
       const InteractionSpec none;
       const InteractionSpec& in = inter ? *inter : none;
       MaterialPair c;
+      c.a = ma;
+      c.b = mb;
       const double nu_a = ma.poisson_ratio, nu_b = mb.poisson_ratio;
       c.e_star = 1.0 / ((1 - nu_a * nu_a) / ma.youngs_modulus + (1 - nu_b * nu_b) / mb.youngs_modulus);
       c.g_star = 1.0 / (2 * (2 - nu_a) * (1 + nu_a) / ma.youngs_modulus +
@@ -120,8 +122,6 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
       c.mu_r = mean_or(in.rolling_friction, ma.rolling_friction, mb.rolling_friction);
       c.zeta_n = mean_or(in.damping_normal, ma.damping_normal, mb.damping_normal);
       c.zeta_t = mean_or(in.damping_tangential, ma.damping_tangential, mb.damping_tangential);
-      if (ma.normal_stiffness > 0 && mb.normal_stiffness > 0)
-        c.normal_stiffness = 0.5 * (ma.normal_stiffness + mb.normal_stiffness);
       table_[a * n_ + b] = c;
     }
   }

@@ -14,8 +14,12 @@
 namespace dem2d {
 
 // The mixed properties of one ordered pair of materials: what every contact law builds its own
-// coefficients from (contact_models.hpp, `Law::coeffs`).
+// coefficients from (contact_models.hpp, `Law::coeffs`). A law that needs a material property
+// not mixed here reads it from the two materials `a` and `b`, e.g.
+// mean(&MaterialSpec::normal_stiffness).
 struct MaterialPair {
+  MaterialSpec a, b;
+  double mean(double MaterialSpec::*property) const { return 0.5 * (a.*property + b.*property); }
   double e_star = 0.0;            // Pa
   double g_star = 0.0;            // Pa
   double restitution = 1.0;       // asked (hertz-mindlin, linear)
@@ -23,7 +27,6 @@ struct MaterialPair {
   double mu_r = 0.0;              // rolling friction
   double zeta_n = 0.0;            // thesis: damping ratios (T22, T23)
   double zeta_t = 0.0;
-  double normal_stiffness = 0.0;  // linear: mean k_n of the two materials, N/m (0: from E*)
 };
 
 class PairTable {
