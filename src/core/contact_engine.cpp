@@ -387,7 +387,7 @@ template <class Registry, class Kind, class F>
 std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
   return [&]<class... Models>(std::type_identity<std::tuple<Models...>>) {
     std::unique_ptr<ContactKernel> out;
-    ((Models::kKind == kind ? (out = f(std::type_identity<Models>{}), true) : false) || ...);
+    static_cast<void>(((Models::kKind == kind ? (out = f(std::type_identity<Models>{}), true) : false) || ...));
     return out;
   }(std::type_identity<Registry>{});
 }

@@ -24,8 +24,8 @@
 // stores, so that kinetic + potential + elastic + dissipated - drive work stays constant.
 //
 // Each law is written once, generic over the value type T: double (one contact) or Pack (a
-// SIMD pack of contacts, core/simd.hpp), and over the coefficient type C (PairCoeffs, or
-// CoeffPack with one coefficient per lane). Branches are selects, so both instantiations
+// SIMD pack of contacts, core/simd.hpp), and over the coefficient type C (the law's
+// Coeffs<double>, or Coeffs<Pack> with one material pair per lane). Branches are selects, so both instantiations
 // perform the same IEEE operations and give the same bits.
 #pragma once
 

@@ -4,12 +4,14 @@
 // trivial and is what the core's tests use. src/parallel/ implements them with MPI (angular
 // sectors, halo exchange, migration) without the physics ever seeing MPI.
 //
-// When the core calls them (core/simulation.cpp):
+// When the core calls them (Simulation::rebuild and refresh_ghosts in core/simulation.cpp, the
+// end-of-step round in core/integrators.cpp):
 //   construction: every rank holds the same full set of particles -> adopt() keeps this
 //     rank's own, then the first rebuild;
 //   a neighbour rebuild (decided with any(), so on every rank at the same step):
 //     migrate() (particles that left this rank's region go to their new owner with every
-//     registered field and the contact histories that involve them) -> exchange_halo() (a new
+//     registered field and the contact histories that involve them, as HistoryRecords sized
+//     from the contact model's declared slots) -> exchange_halo() (a new
 //     ghost set) -> the core builds the neighbour lists over owned + ghosts;
 //   every other force evaluation: refresh_ghosts() (positions, velocities, spins of the same
 //     ghosts, in the same slots);
