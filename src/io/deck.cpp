@@ -2,10 +2,13 @@
 //
 // One toml::table goes through three stages. The overrides are applied to the tree, and every
 // node they make is remembered with the option's text (Origins), so that a message about it
-// names the option. Then a DeckParser reads every table through a TableReader, which checks
-// types and ranges, reports unknown keys with the closest valid one, and adds every message to
-// one Diagnostics. Last come the checks across tables (material references, particle sources).
-// Nothing throws before all of that has run, except a TOML syntax error (no tree to check).
+// names the option. Then a DeckParser reads every table in two passes. The per-key pass walks
+// the table's description (deck_schema.hpp): a TableReader checks each key's type, range and
+// presence and reports unknown keys with the closest valid one; each accepted value goes into
+// the Scene through the key's field. The rules between keys of the table follow as code (one
+// of speed / speed_rpm / critical_fraction, ...), then the checks across tables (material
+// references, particle sources). Every message goes to one Diagnostics; nothing throws before
+// all of that has run, except a TOML syntax error (no tree to check).
 #include "io/deck.hpp"
 
 #include <fmt/format.h>
@@ -18,7 +21,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <limits>
 #include <map>
 #include <optional>
 #include <span>
@@ -36,10 +38,10 @@ namespace dem2d {
 namespace {
 
 namespace fs = std::filesystem;
-using Keys = std::span<const std::string_view>;
-using deck::Choice;
-
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
+using deck::Bound;
+using deck::Need;
+using deck::Type;
+using deck::Value;
 
 // ---------------------------------------------------------------------------------------------
 // Text helpers
@@ -136,56 +138,44 @@ class Diagnostics {
   std::vector<std::string_view> lines_;
 };
 
-// ---------------------------------------------------------------------------------------------
-// TableReader: typed, checked reads of one table's keys
-
-// The allowed interval of a number, and its wording ("> 0", "in (0, 1]").
-struct Bound {
-  double lo = -kInfinity;
-  double hi = kInfinity;
-  bool lo_open = false;
-  bool hi_open = false;
-
-  bool contains(double v) const {
-    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+// What a key of `type` must hold, for messages: "a number > 0", "an array of two numbers [x, y]".
+std::string expected_text(Type type, const Bound& bound) {
+  switch (type) {
+    case Type::kNumber:
+      return bound.unbounded() ? "a number" : "a number " + bound.text();
+    case Type::kInteger:
+      return "an integer " + bound.text();
+    case Type::kVector:
+      return "an array of two numbers [x, y]";
+    case Type::kMaterialPair:
+      return "two material names [\"a\", \"b\"]";
+    default:
+      return "a string";  // kString, kMaterial, kChoice
   }
-  bool unbounded() const { return lo == -kInfinity && hi == kInfinity; }
-  std::string text() const {
-    if (hi == kInfinity) return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
-    if (lo == -kInfinity) return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
-    return fmt::format("in {}{}, {}{}", lo_open ? '(' : '[', lo, hi, hi_open ? ')' : ']');
-  }
-};
+}
 
-constexpr Bound kAnyNumber{};
-constexpr Bound kPositive{0.0, kInfinity, true, false};      // > 0
-constexpr Bound kNonNegative{0.0, kInfinity, false, false};  // >= 0
-constexpr Bound kRestitution{0.0, 1.0, true, false};         // (0, 1]
-constexpr Bound kUnitFraction{0.0, 1.0, true, false};        // (0, 1]
-constexpr Bound kPoissonRatio{0.0, 0.5, false, true};        // [0, 0.5): isotropic, compressible
-constexpr Bound kFillFraction{0.0, 0.9, true, true};         // (0, 0.9): room left to place them
-constexpr Bound kAtLeastOne{1.0, kInfinity, false, false};   // >= 1 (integers)
-
-enum class Need { kOptional, kRequired };
-
-template <class T>
-void set_if(T& target, const std::optional<T>& value) {
-  if (value) target = *value;
+template <class V>
+std::optional<Value> as_value(std::optional<V> value) {
+  if (!value) return std::nullopt;
+  return Value(std::move(*value));
 }
 
 class TableReader {
  public:
-  // `path`: the table's dotted path in messages ("material[1]", "" for the root); `header`: the
-  // table as a deck writes it ("[[material]]"); `schema`: its path without indices
-  // ("drum.lifter"), for naming unknown sub-tables.
-  TableReader(Diagnostics& diag, const toml::table& table, std::string path, std::string header,
-              std::string schema, Keys valid_keys)
+  // Reads `table` as the described table `spec`; `index`: its element of an array of tables.
+  // Messages name it by its dotted path ("material[1]", "" for the root) and, for unknown keys,
+  // as a deck writes it ("[[material]]") or by its path without indices ("drum.lifter").
+  template <class T>
+  TableReader(Diagnostics& diag, const toml::table& table, const deck::Table<T>& spec,
+              std::optional<std::size_t> index = std::nullopt)
       : diag_(diag),
         table_(table),
-        path_(std::move(path)),
-        header_(std::move(header)),
-        schema_(std::move(schema)),
-        valid_keys_(valid_keys) {}
+        path_(index ? fmt::format("{}[{}]", spec.path, *index) : std::string(spec.path)),
+        header_(spec.path.empty() ? std::string()
+                : spec.repeated   ? fmt::format("[[{}]]", spec.path)
+                                  : fmt::format("[{}]", spec.path)),
+        schema_(spec.path),
+        valid_keys_(deck::key_names(spec.keys)) {}
 
   const std::string& path() const { return path_; }
   const toml::table& table() const { return table_; }
@@ -212,9 +202,9 @@ class TableReader {
     error(fmt::format("{} is required ({})", path_of(key), what));
   }
 
-  std::optional<double> number(std::string_view key, const Bound& bound = kAnyNumber,
+  std::optional<double> number(std::string_view key, const Bound& bound = deck::kAnyNumber,
                                Need need = Need::kOptional) const {
-    const std::string expected = bound.unbounded() ? "a number" : "a number " + bound.text();
+    const std::string expected = expected_text(Type::kNumber, bound);
     const toml::node* node = find(key);
     if (node == nullptr) {
       if (need == Need::kRequired) missing(key, expected);
@@ -239,7 +229,7 @@ class TableReader {
   std::optional<std::int64_t> integer(std::string_view key, const Bound& bound,
                                       Need need = Need::kOptional,
                                       std::int64_t max = INT_MAX) const {
-    const std::string expected = "an integer " + bound.text();
+    const std::string expected = expected_text(Type::kInteger, bound);
     const toml::node* node = find(key);
     if (node == nullptr) {
       if (need == Need::kRequired) missing(key, expected);
@@ -272,7 +262,7 @@ class TableReader {
   std::optional<std::string> string(std::string_view key, Need need = Need::kOptional) const {
     const toml::node* node = find(key);
     if (node == nullptr) {
-      if (need == Need::kRequired) missing(key, "a string");
+      if (need == Need::kRequired) missing(key, expected_text(Type::kString, {}));
       return std::nullopt;
     }
     if (const auto* s = node->as_string()) return s->get();
@@ -284,7 +274,7 @@ class TableReader {
   std::optional<Vec2> pair(std::string_view key, Need need = Need::kOptional) const {
     const toml::node* node = find(key);
     if (node == nullptr) {
-      if (need == Need::kRequired) missing(key, "an array of two numbers [x, y]");
+      if (need == Need::kRequired) missing(key, expected_text(Type::kVector, {}));
       return std::nullopt;
     }
     const auto* array = node->as_array();
@@ -308,16 +298,12 @@ class TableReader {
   }
 
   // One of a fixed set of words; a near miss gets a suggestion.
-  template <class E, std::size_t N>
-  std::optional<E> choice(std::string_view key, const std::array<Choice<E>, N>& choices) const {
+  std::optional<std::string> choice(std::string_view key,
+                                    std::span<const std::string_view> names) const {
     const toml::node* node = find(key);
     if (node == nullptr) return std::nullopt;
-    std::vector<std::string_view> names;
-    for (const auto& c : choices) names.push_back(c.name);
     if (const auto* s = node->as_string()) {
-      for (const auto& c : choices) {
-        if (c.name == s->get()) return c.value;
-      }
+      if (std::find(names.begin(), names.end(), s->get()) != names.end()) return s->get();
       std::string what = "must be one of " + quoted_list(names);
       if (const auto near = closest_match(s->get(), names)) {
         what += fmt::format("; did you mean {}?", quoted_string(*near));
@@ -327,6 +313,19 @@ class TableReader {
     }
     invalid(key, "expected a string, one of " + quoted_list(names));
     return std::nullopt;
+  }
+
+  // A number in `bound` or the word "auto" (run.dt); `unit` is named in the message.
+  std::optional<Value> number_or_auto(std::string_view key, const Bound& bound,
+                                      std::string_view unit) const {
+    const toml::node* node = find(key);
+    if (node == nullptr) return std::nullopt;
+    if (node->is_string() && node->as_string()->get() == "auto") return Value(std::string("auto"));
+    if (!node->is_number()) {
+      invalid(key, fmt::format("expected a number {} ({}) or \"auto\"", bound.text(), unit));
+      return std::nullopt;
+    }
+    return as_value(number(key, bound));
   }
 
   // A sub-table [name] (nullptr when absent or of another type, which is reported).
@@ -379,7 +378,7 @@ class TableReader {
     for (const auto& [key, value] : table_) {
       const std::string_view name = key.str();
       if (std::find(valid_keys_.begin(), valid_keys_.end(), name) != valid_keys_.end()) continue;
-      const auto near = closest_match(name, valid_keys_);
+      const auto near = closest_match(name, std::span<const std::string_view>(valid_keys_));
       const std::string prefix = schema_.empty() ? "" : schema_ + ".";
       std::string message;
       if (value.is_table() || value.is_array_of_tables()) {
@@ -403,7 +402,7 @@ class TableReader {
   std::string path_;
   std::string header_;
   std::string schema_;
-  Keys valid_keys_;
+  std::vector<std::string_view> valid_keys_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -425,11 +424,6 @@ void forget_origin(const toml::node& node, Origins& origins) {
   } else if (const auto* a = node.as_array()) {
     for (const auto& item : *a) forget_origin(item, origins);
   }
-}
-
-bool is_table_array(std::string_view dotted) {
-  return std::find(deck::kTableArrays.begin(), deck::kTableArrays.end(), dotted) !=
-         deck::kTableArrays.end();
 }
 
 bool is_index(std::string_view s) {
@@ -516,7 +510,7 @@ void apply_override(toml::table& root, const std::string& option, Origins& origi
     schema = schema.empty() ? segment : schema + "." + segment;
     shown = shown.empty() ? segment : shown + "." + segment;
     toml::node* node = table->get(segment);
-    if (is_table_array(schema)) {
+    if (deck::is_table_array(schema)) {
       toml::array* array = node != nullptr ? node->as_array() : nullptr;
       if (array == nullptr) {
         fail(fmt::format("the deck has no [[{}]] table", schema));
@@ -548,7 +542,7 @@ void apply_override(toml::table& root, const std::string& option, Origins& origi
   }
   const std::string& last = segments.back();
   const std::string last_schema = schema.empty() ? last : schema + "." + last;
-  if (is_table_array(last_schema)) {
+  if (deck::is_table_array(last_schema)) {
     fail(fmt::format("cannot set all of [[{}]]; set one key of one element: {}.INDEX.KEY",
                      last_schema, last_schema));
     return;
@@ -561,15 +555,44 @@ void apply_override(toml::table& root, const std::string& option, Origins& origi
 // ---------------------------------------------------------------------------------------------
 // DeckParser: the tree -> a Scene, every table and every cross-reference checked
 
+// The values that the per-key pass accepted in one table, by key, for the rules between keys.
+class Accepted {
+ public:
+  void add(std::string_view key, Value value) { values_.emplace_back(key, std::move(value)); }
+  bool has(std::string_view key) const { return find(key) != nullptr; }
+  template <class V>
+  std::optional<V> get(std::string_view key) const {
+    const Value* value = find(key);
+    if (value == nullptr || !std::holds_alternative<V>(*value)) return std::nullopt;
+    return std::get<V>(*value);
+  }
+
+ private:
+  const Value* find(std::string_view key) const {
+    for (const auto& [name, value] : values_) {
+      if (name == key) return &value;
+    }
+    return nullptr;
+  }
+  std::vector<std::pair<std::string_view, Value>> values_;
+};
+
+// A key that the keys around it make required (a fill's material, unless it reads a file).
+template <class T>
+void require(const TableReader& r, const deck::Table<T>& spec, std::string_view name) {
+  if (r.has(name)) return;
+  const deck::Key<T>* key = deck::find_key(spec.keys, name);
+  r.missing(name, expected_text(key->type, key->range));
+}
+
 class DeckParser {
  public:
   DeckParser(const toml::table& root, Diagnostics& diag, fs::path deck_dir)
       : root_(root), diag_(diag), deck_dir_(std::move(deck_dir)) {}
 
   Scene parse() {
-    const TableReader root(diag_, root_, "", "", "", deck::kRootKeys);
-    root.check_unknown_keys();
-    set_if(scene_.title, root.string("title"));
+    const TableReader root(diag_, root_, deck::kTopLevel);
+    read_keys(root, deck::kTopLevel, scene_);  // the title; the tables below
     if (const auto* t = root.table("run")) read_run(*t);
     if (const auto* t = root.table("contact")) read_contact(*t);
     const auto materials = root.table_array("material");
@@ -600,140 +623,112 @@ class DeckParser {
   }
 
  private:
-  void read_run(const toml::table& table) {
-    const TableReader r(diag_, table, "run", "[run]", "run", deck::kRunKeys);
+  // The per-key pass over one table: unknown keys, then each described key's presence, type,
+  // range and contact model. An accepted value goes into `target` through the key's field and
+  // is returned for the rules between keys, which the caller checks next. (A value that breaks
+  // such a rule may already be stored: the error discards the whole Scene.)
+  template <class T>
+  Accepted read_keys(const TableReader& r, const deck::Table<T>& spec, T& target) {
     r.check_unknown_keys();
-    RunSpec& run = scene_.run;
-    set_if(run.duration, r.number("duration", kPositive));
-    if (const toml::node* dt = r.find("dt")) {
-      if (dt->is_string() && dt->as_string()->get() == "auto") {
-        run.dt_auto = true;
-        run.dt = 0.0;
-      } else if (!dt->is_number()) {
-        r.invalid("dt", "expected a number > 0 (s) or \"auto\"");
-      } else if (const auto value = r.number("dt", kPositive)) {
-        run.dt_auto = false;
-        run.dt = *value;
+    Accepted accepted;
+    for (const deck::Key<T>& key : spec.keys) {
+      if (model_ && r.has(key.name) && !deck::takes(key.models, *model_)) {
+        // Another model's coefficient is an error rather than silently unused.
+        r.invalid(key.name, fmt::format("not used by contact.model = \"{}\", which takes {}",
+                                        deck::choice_name(deck::kContactModels, *model_),
+                                        deck::model_coefficients(*model_)));
+        continue;
       }
+      std::optional<Value> value = read_value(r, key);
+      if (!value) continue;
+      if (key.field.store != nullptr) key.field.store(target, *value);
+      accepted.add(key.name, std::move(*value));
     }
-    set_if(run.integrator, r.choice("integrator", deck::kIntegrators));
-    set_if(run.tolerance, r.number("tolerance", kPositive));
-    if (const auto passes = r.integer("max_passes", kAtLeastOne)) {
-      run.max_passes = static_cast<int>(*passes);
+    return accepted;
+  }
+
+  // One key checked by its type: the value, or nullopt when absent or invalid (reported).
+  template <class T>
+  std::optional<Value> read_value(const TableReader& r, const deck::Key<T>& key) {
+    switch (key.type) {
+      case Type::kNumber:
+        return as_value(r.number(key.name, key.range, key.need));
+      case Type::kInteger:
+        return as_value(r.integer(key.name, key.range, key.need, key.max));
+      case Type::kBool:
+        return as_value(r.boolean(key.name));
+      case Type::kString:
+        return as_value(r.string(key.name, key.need));
+      case Type::kMaterial:
+        return as_value(material_ref(r, key.name, key.need));
+      case Type::kChoice:
+        return as_value(r.choice(key.name, key.choices));
+      case Type::kVector:
+        return as_value(r.pair(key.name, key.need));
+      case Type::kNumberOrAuto:
+        return r.number_or_auto(key.name, key.range, key.unit);
+      case Type::kMaterialPair:
+        return as_value(material_pair(r, key.name, key.need));
+      case Type::kTable:
+      case Type::kTableArray:
+        break;  // read by the caller, as its own table
     }
-    if (const auto seed = r.integer("seed", kNonNegative, Need::kOptional, INT64_MAX)) {
-      run.seed = static_cast<std::uint64_t>(*seed);
-    }
-    set_if(run.gravity, r.pair("gravity"));
-    set_if(run.skin, r.number("skin", kNonNegative));
-    set_if(run.dt_safety, r.number("dt_safety", kUnitFraction));
-    set_if(run.allow_unsafe_dt, r.boolean("allow_unsafe_dt"));
-    if (const auto sectors = r.integer("sectors_per_rank", kAtLeastOne, Need::kOptional, 4096)) {
-      run.sectors_per_rank = static_cast<int>(*sectors);
-    }
-    set_if(run.repartition_threshold, r.number("repartition_threshold", kPositive));
+    return std::nullopt;
+  }
+
+  void read_run(const toml::table& table) {
+    read_keys(TableReader(diag_, table, deck::kRun), deck::kRun, scene_.run);
   }
 
   void read_contact(const toml::table& table) {
-    const TableReader r(diag_, table, "contact", "[contact]", "contact", deck::kContactKeys);
-    r.check_unknown_keys();
-    ContactSpec& contact = scene_.contact;
-    if (r.has("model")) {
-      model_ = r.choice("model", deck::kContactModels);
-      set_if(contact.model, model_);
-    }
-    set_if(contact.rolling, r.choice("rolling", deck::kRollingModels));
-    set_if(contact.rolling_damping, r.number("rolling_damping", kNonNegative));
-  }
-
-  // The coefficients only some contact models take: restitution (hertz-mindlin, linear), the
-  // damping ratios (thesis) and normal_stiffness (linear). Another model's coefficient is an
-  // error rather than silently unused. Unknown model (already reported): anything goes.
-  bool model_takes(std::string_view key) const {
-    if (!model_) return true;
-    if (key == "restitution") return *model_ != ContactModelKind::kThesis;
-    if (key == "damping_normal" || key == "damping_tangential") {
-      return *model_ == ContactModelKind::kThesis;
-    }
-    if (key == "normal_stiffness") return *model_ == ContactModelKind::kLinear;
-    return true;
-  }
-
-  static std::string_view model_coefficients(ContactModelKind model) {
-    switch (model) {
-      case ContactModelKind::kHertzMindlin:
-        return "restitution";
-      case ContactModelKind::kThesis:
-        return "damping_normal and damping_tangential";
-      case ContactModelKind::kLinear:
-        return "restitution and normal_stiffness";
-    }
-    return "";
-  }
-
-  // Reads a model-dependent coefficient, or reports it as not used by the model.
-  std::optional<double> model_coefficient(const TableReader& r, std::string_view key,
-                                          const Bound& bound) const {
-    if (!r.has(key)) return std::nullopt;
-    if (!model_takes(key)) {
-      r.invalid(key, fmt::format("not used by contact.model = \"{}\", which takes {}",
-                                 deck::choice_name(deck::kContactModels, *model_),
-                                 model_coefficients(*model_)));
-      return std::nullopt;
-    }
-    return r.number(key, bound);
+    const TableReader r(diag_, table, deck::kContact);
+    const Accepted accepted = read_keys(r, deck::kContact, scene_.contact);
+    // An invalid model (reported) turns the model-dependent checks of the materials off.
+    model_.reset();
+    if (accepted.has("model") || !r.has("model")) model_ = scene_.contact.model;
   }
 
   void read_material(const toml::table& table, std::size_t index) {
-    const TableReader r(diag_, table, fmt::format("material[{}]", index), "[[material]]",
-                        "material", deck::kMaterialKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kMaterial, index);
     MaterialSpec m;
-    if (const auto name = r.string("name", Need::kRequired)) {
-      const auto same = std::find(material_names_.begin(), material_names_.end(), *name);
-      if (name->empty() || name->find('.') != std::string::npos) {
+    const Accepted accepted = read_keys(r, deck::kMaterial, m);
+    if (accepted.has("name")) {
+      const auto same = std::find(material_names_.begin(), material_names_.end(), m.name);
+      if (m.name.empty() || m.name.find('.') != std::string::npos) {
         r.invalid("name", "must be a non-empty name without '.'");
+        m.name.clear();
       } else if (same != material_names_.end()) {
         r.invalid("name",
                   fmt::format("already the name of material[{}]", same - material_names_.begin()));
-      } else {
-        m.name = *name;
+        m.name.clear();
       }
     }
-    const auto density = r.number("density", kPositive, Need::kRequired);
-    const auto youngs = r.number("youngs_modulus", kPositive, Need::kRequired);
-    set_if(m.density, density);
-    set_if(m.youngs_modulus, youngs);
-    // Isotropic elasticity: G = E / (2 (1 + nu)), nu = E / (2 G) - 1; one of the two is given.
+    read_elasticity(r, accepted, m);
+    material_names_.push_back(m.name);  // "" for an invalid name: index stays aligned
+    scene_.materials.push_back(std::move(m));
+  }
+
+  // Isotropic elasticity: G = E / (2 (1 + nu)), nu = E / (2 G) - 1; one of the two is given.
+  static void read_elasticity(const TableReader& r, const Accepted& accepted, MaterialSpec& m) {
+    const auto youngs = accepted.get<double>("youngs_modulus");
     if (r.has("poisson_ratio") && r.has("shear_modulus")) {
       r.error_at("shear_modulus",
                  fmt::format("{}: give poisson_ratio or shear_modulus, not both", r.path()));
     } else if (r.has("shear_modulus")) {
-      const auto shear = r.number("shear_modulus", kPositive);
-      if (shear && youngs) {
-        const double nu = *youngs / (2.0 * *shear) - 1.0;
-        if (nu >= -1.0 && nu < 0.5) {
-          m.shear_modulus = *shear;
-          m.poisson_ratio = nu;
-        } else {
-          r.invalid("shear_modulus",
-                    fmt::format("gives poisson_ratio = youngs_modulus / (2 shear_modulus) - 1 "
-                                "= {}, which must be in [-1, 0.5) (shear_modulus > {})",
-                                nu, *youngs / 3.0));
-        }
+      const auto shear = accepted.get<double>("shear_modulus");
+      if (!shear || !youngs) return;
+      const double nu = *youngs / (2.0 * *shear) - 1.0;
+      if (nu >= -1.0 && nu < 0.5) {
+        m.poisson_ratio = nu;
+      } else {
+        r.invalid("shear_modulus",
+                  fmt::format("gives poisson_ratio = youngs_modulus / (2 shear_modulus) - 1 "
+                              "= {}, which must be in [-1, 0.5) (shear_modulus > {})",
+                              nu, *youngs / 3.0));
       }
-    } else {
-      set_if(m.poisson_ratio, r.number("poisson_ratio", kPoissonRatio));
-      if (youngs) m.shear_modulus = *youngs / (2.0 * (1.0 + m.poisson_ratio));
+    } else if (youngs) {
+      m.shear_modulus = *youngs / (2.0 * (1.0 + m.poisson_ratio));
     }
-    set_if(m.restitution, model_coefficient(r, "restitution", kRestitution));
-    set_if(m.damping_normal, model_coefficient(r, "damping_normal", kNonNegative));
-    set_if(m.damping_tangential, model_coefficient(r, "damping_tangential", kNonNegative));
-    set_if(m.normal_stiffness, model_coefficient(r, "normal_stiffness", kPositive));
-    set_if(m.sliding_friction, r.number("sliding_friction", kNonNegative));
-    set_if(m.rolling_friction, r.number("rolling_friction", kNonNegative));
-    material_names_.push_back(m.name);  // "" for an invalid name: index stays aligned
-    scene_.materials.push_back(std::move(m));
   }
 
   // The valid material names, in deck order.
@@ -769,57 +764,64 @@ class DeckParser {
     return name;
   }
 
-  void read_interaction(const toml::table& table, std::size_t index) {
-    const TableReader r(diag_, table, fmt::format("interaction[{}]", index), "[[interaction]]",
-                        "interaction", deck::kInteractionKeys);
-    r.check_unknown_keys();
-    InteractionSpec spec;
-    if (const toml::node* node = r.find("materials")) {
-      const auto* array = node->as_array();
-      if (array == nullptr || array->size() != 2 || !array->get(0)->is_string() ||
-          !array->get(1)->is_string()) {
-        r.invalid("materials", "expected two material names [\"a\", \"b\"]");
-      } else {
-        bool known = true;
-        std::string names[2];
-        for (std::size_t i = 0; i < 2; ++i) {
-          names[i] = array->get(i)->as_string()->get();
-          known &= check_material_name(*array->get(i), fmt::format("{}.materials[{}]", r.path(), i),
-                                       names[i]);
-        }
-        if (known) {
-          auto pair = std::minmax(names[0], names[1]);
-          const auto key = std::make_pair(pair.first, pair.second);
-          if (const auto seen = interaction_pairs_.find(key); seen != interaction_pairs_.end()) {
-            r.invalid("materials",
-                      fmt::format("this pair already has interaction[{}]", seen->second));
-          } else {
-            interaction_pairs_.emplace(key, index);
-          }
-          spec.material_a = names[0];
-          spec.material_b = names[1];
-        }
-      }
-    } else {
-      r.missing("materials", "two material names [\"a\", \"b\"]");
+  // ["a", "b"]: two defined material names (nullopt when absent or invalid, which is reported).
+  std::optional<deck::Names> material_pair(const TableReader& r, std::string_view key, Need need) {
+    const toml::node* node = r.find(key);
+    if (node == nullptr) {
+      if (need == Need::kRequired) r.missing(key, expected_text(Type::kMaterialPair, {}));
+      return std::nullopt;
     }
-    spec.restitution = model_coefficient(r, "restitution", kRestitution);
-    spec.damping_normal = model_coefficient(r, "damping_normal", kNonNegative);
-    spec.damping_tangential = model_coefficient(r, "damping_tangential", kNonNegative);
-    spec.sliding_friction = r.number("sliding_friction", kNonNegative);
-    spec.rolling_friction = r.number("rolling_friction", kNonNegative);
+    const auto* array = node->as_array();
+    if (array == nullptr || array->size() != 2 || !array->get(0)->is_string() ||
+        !array->get(1)->is_string()) {
+      r.invalid(key, "expected " + expected_text(Type::kMaterialPair, {}));
+      return std::nullopt;
+    }
+    deck::Names names(2);
+    bool known = true;
+    for (std::size_t i = 0; i < 2; ++i) {
+      names[i] = array->get(i)->as_string()->get();
+      known &=
+          check_material_name(*array->get(i), fmt::format("{}[{}]", r.path_of(key), i), names[i]);
+    }
+    if (!known) return std::nullopt;
+    return names;
+  }
+
+  void read_interaction(const toml::table& table, std::size_t index) {
+    const TableReader r(diag_, table, deck::kInteraction, index);
+    InteractionSpec spec;
+    if (read_keys(r, deck::kInteraction, spec).has("materials")) {
+      const auto pair = std::minmax(spec.material_a, spec.material_b);
+      const auto key = std::make_pair(pair.first, pair.second);
+      if (const auto seen = interaction_pairs_.find(key); seen != interaction_pairs_.end()) {
+        r.invalid("materials", fmt::format("this pair already has interaction[{}]", seen->second));
+      } else {
+        interaction_pairs_.emplace(key, index);
+      }
+    }
     scene_.interactions.push_back(std::move(spec));
   }
 
   void read_drum(const toml::table& table) {
-    const TableReader r(diag_, table, "drum", "[drum]", "drum", deck::kDrumKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kDrum);
     DrumSpec& drum = scene_.drum;
     drum.present = true;
-    const auto radius = r.number("radius", kPositive, Need::kRequired);
-    set_if(drum.radius, radius);
-    set_if(drum.center, r.pair("center"));
+    const Accepted accepted = read_keys(r, deck::kDrum, drum);
+    const auto radius = accepted.get<double>("radius");
+    read_drum_speed(r, accepted, radius);
+    if (const auto sides = accepted.get<std::int64_t>("sides");
+        sides && (*sides == 1 || *sides == 2)) {
+      r.invalid("sides", "must be 0 (a circle) or >= 3 (a regular polygon)");
+    }
+    const auto lifters = r.table_array("lifter");
+    for (std::size_t i = 0; i < lifters.size(); ++i) read_lifter(*lifters[i], i, radius);
+  }
 
+  // At most one of speed, speed_rpm and critical_fraction. The per-key pass stored the first
+  // two (in rad/s); the critical fraction needs the gravity and the radius.
+  void read_drum_speed(const TableReader& r, const Accepted& accepted,
+                       std::optional<double> radius) {
     std::vector<std::string_view> speeds;
     for (const std::string_view key : {"speed", "speed_rpm", "critical_fraction"}) {
       if (r.has(key)) speeds.push_back(key);
@@ -828,75 +830,42 @@ class DeckParser {
       r.error_at(speeds[1], fmt::format("drum: give only one of speed, speed_rpm and "
                                         "critical_fraction (found {})",
                                         and_list(speeds)));
-    } else if (speeds.size() == 1 && speeds[0] == "speed") {
-      set_if(drum.speed, r.number("speed"));  // rad/s, counter-clockwise positive
-    } else if (speeds.size() == 1 && speeds[0] == "speed_rpm") {
-      if (const auto rpm = r.number("speed_rpm")) drum.speed = *rpm * kRadPerSecondPerRpm;
-    } else if (speeds.size() == 1) {
-      // Classical critical speed w_c = sqrt(|g| / R): a point on the shell just stays on it.
-      const auto fraction = r.number("critical_fraction");
-      const double g = norm(scene_.run.gravity);
-      if (fraction && g == 0.0) {
-        r.invalid("critical_fraction", "needs a non-zero run.gravity (w_c = sqrt(|g| / R))");
-      } else if (fraction && radius) {
-        drum.speed = *fraction * std::sqrt(g / *radius);
-      }
+      return;
     }
-    set_if(drum.ramp_time, r.number("ramp_time", kNonNegative));
-    if (const auto sides = r.integer("sides", kNonNegative)) {
-      if (*sides == 1 || *sides == 2) {
-        r.invalid("sides", "must be 0 (a circle) or >= 3 (a regular polygon)");
-      } else {
-        drum.sides = static_cast<int>(*sides);
-      }
+    const auto fraction = accepted.get<double>("critical_fraction");
+    if (!fraction) return;
+    // Classical critical speed w_c = sqrt(|g| / R): a point on the shell just stays on it.
+    const double g = norm(scene_.run.gravity);
+    if (g == 0.0) {
+      r.invalid("critical_fraction", "needs a non-zero run.gravity (w_c = sqrt(|g| / R))");
+    } else if (radius) {
+      scene_.drum.speed = *fraction * std::sqrt(g / *radius);
     }
-    if (const auto degrees = r.number("angle")) drum.angle = *degrees * kRadiansPerDegree;
-    set_if(drum.material, material_ref(r, "material", Need::kRequired));
-    const auto lifters = r.table_array("lifter");
-    for (std::size_t i = 0; i < lifters.size(); ++i) read_lifter(*lifters[i], i, radius);
   }
 
   void read_lifter(const toml::table& table, std::size_t index, std::optional<double> radius) {
-    const TableReader r(diag_, table, fmt::format("drum.lifter[{}]", index), "[[drum.lifter]]",
-                        "drum.lifter", deck::kLifterKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kLifter, index);
     LifterSpec lifter;
-    if (const auto count = r.integer("count", kAtLeastOne, Need::kRequired)) {
-      lifter.count = static_cast<int>(*count);
+    const auto height = read_keys(r, deck::kLifter, lifter).get<double>("height");
+    if (height && radius && *height >= *radius) {
+      r.invalid("height", fmt::format("must be < drum.radius = {}", *radius));
     }
-    if (const auto height = r.number("height", kPositive, Need::kRequired)) {
-      if (radius && *height >= *radius) {
-        r.invalid("height", fmt::format("must be < drum.radius = {}", *radius));
-      } else {
-        lifter.height = *height;
-      }
-    }
-    set_if(lifter.width, r.number("width", kPositive, Need::kRequired));
-    if (const auto degrees = r.number("angle")) lifter.angle = *degrees * kRadiansPerDegree;
-    set_if(lifter.material, material_ref(r, "material", Need::kOptional));
     scene_.drum.lifters.push_back(std::move(lifter));
   }
 
   void read_particle(const toml::table& table, std::size_t index) {
-    const TableReader r(diag_, table, fmt::format("particle[{}]", index), "[[particle]]",
-                        "particle", deck::kParticleKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kParticle, index);
     ParticleSpec p;
-    set_if(p.material, material_ref(r, "material", Need::kRequired));
-    set_if(p.radius, r.number("radius", kPositive, Need::kRequired));
-    set_if(p.position, r.pair("position", Need::kRequired));
-    set_if(p.velocity, r.pair("velocity"));
-    set_if(p.spin, r.number("spin"));
+    read_keys(r, deck::kParticle, p);
     p.source_line = r.line();
     scene_.particles.push_back(std::move(p));
   }
 
   void read_fill(const toml::table& table, std::size_t index) {
-    const TableReader r(diag_, table, fmt::format("fill[{}]", index), "[[fill]]", "fill",
-                        deck::kFillKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kFill, index);
     FillSpec fill;
     fill.source_line = r.line();
+    const Accepted accepted = read_keys(r, deck::kFill, fill);
     std::vector<std::string_view> sources;
     for (const std::string_view key : {"count", "fill_fraction", "file"}) {
       if (r.has(key)) sources.push_back(key);
@@ -907,70 +876,52 @@ class DeckParser {
                   : fmt::format("{}: give only one of count, fill_fraction and file (found {})",
                                 r.path(), and_list(sources)));
     }
-    const bool is_file = sources.size() == 1 && sources[0] == "file";
-    set_if(fill.material, material_ref(r, "material", is_file ? Need::kOptional : Need::kRequired));
-    set_if(fill.velocity, r.pair("velocity"));
-    if (is_file) {
+    if (sources.size() == 1 && sources[0] == "file") {
       for (const std::string_view key :
            {"radius", "radius_min", "radius_max", "region", "box_min", "box_max"}) {
         if (r.has(key))
           r.invalid(key, "not used by a fill from a file (the file gives each particle)");
       }
-      if (const auto file = r.string("file")) read_fill_file(r, *file, fill);
+      if (const auto file = accepted.get<std::string>("file")) read_fill_file(r, *file, fill);
       return;
     }
-    if (const auto count = r.integer("count", kAtLeastOne, Need::kOptional, INT64_MAX)) {
-      fill.count = *count;
+    require(r, deck::kFill, "material");  // a file may name each row's material instead
+    if (accepted.has("fill_fraction") && !scene_.drum.present) {
+      r.invalid("fill_fraction", "needs a [drum] (it is a fraction of the drum's area)");
     }
-    if (r.has("fill_fraction")) {
-      const auto fraction = r.number("fill_fraction", kFillFraction);
-      if (fraction && !scene_.drum.present) {
-        r.invalid("fill_fraction", "needs a [drum] (it is a fraction of the drum's area)");
-      } else {
-        set_if(fill.fill_fraction, fraction);
-      }
-    }
-    read_fill_radii(r, fill);
-    read_fill_region(r, fill);
+    read_fill_radii(r, accepted);
+    read_fill_region(r, accepted, fill);
     scene_.fills.push_back(std::move(fill));
   }
 
   // radius (mono-disperse) or radius_min and radius_max (uniform in r between them).
-  void read_fill_radii(const TableReader& r, FillSpec& fill) {
+  static void read_fill_radii(const TableReader& r, const Accepted& accepted) {
     const bool has_range = r.has("radius_min") || r.has("radius_max");
     if (r.has("radius") && has_range) {
       r.error(fmt::format("{}: give radius, or radius_min and radius_max, not both", r.path()));
-    } else if (r.has("radius")) {
-      if (const auto radius = r.number("radius", kPositive)) {
-        fill.radius_min = fill.radius_max = *radius;
-      }
     } else if (has_range) {
-      const auto lo = r.number("radius_min", kPositive, Need::kRequired);
-      const auto hi = r.number("radius_max", kPositive, Need::kRequired);
+      require(r, deck::kFill, "radius_min");
+      require(r, deck::kFill, "radius_max");
+      const auto lo = accepted.get<double>("radius_min");
+      const auto hi = accepted.get<double>("radius_max");
       if (lo && hi && *lo > *hi) {
         r.invalid("radius_min", fmt::format("must be <= radius_max = {}", r.shown("radius_max")));
-      } else if (lo && hi) {
-        fill.radius_min = *lo;
-        fill.radius_max = *hi;
       }
-    } else {
+    } else if (!r.has("radius")) {
       r.error(fmt::format("{} needs radius, or radius_min and radius_max (m, > 0)", r.path()));
     }
   }
 
-  void read_fill_region(const TableReader& r, FillSpec& fill) {
-    const auto region = r.choice("region", deck::kFillRegions);
-    if (r.has("region") && !region) return;  // reported
-    set_if(fill.region, region);
+  void read_fill_region(const TableReader& r, const Accepted& accepted, const FillSpec& fill) {
+    if (r.has("region") && !accepted.has("region")) return;  // reported
     if (fill.region == FillRegion::kBox) {
-      const auto lo = r.pair("box_min", Need::kRequired);
-      const auto hi = r.pair("box_max", Need::kRequired);
+      require(r, deck::kFill, "box_min");
+      require(r, deck::kFill, "box_max");
+      const auto lo = accepted.get<Vec2>("box_min");
+      const auto hi = accepted.get<Vec2>("box_max");
       if (lo && hi && !(lo->x < hi->x && lo->y < hi->y)) {
         r.invalid("box_max", fmt::format("must be above and to the right of box_min = {}",
                                          r.shown("box_min")));
-      } else if (lo && hi) {
-        fill.box_min = *lo;
-        fill.box_max = *hi;
       }
       return;
     }
@@ -1029,41 +980,27 @@ class DeckParser {
   }
 
   void read_wall(const toml::table& table, std::size_t index) {
-    const TableReader r(diag_, table, fmt::format("wall[{}]", index), "[[wall]]", "wall",
-                        deck::kWallKeys);
-    r.check_unknown_keys();
+    const TableReader r(diag_, table, deck::kWall, index);
     WallSpec wall;
-    const auto from = r.pair("from", Need::kRequired);
-    const auto to = r.pair("to", Need::kRequired);
+    const Accepted accepted = read_keys(r, deck::kWall, wall);
+    const auto from = accepted.get<Vec2>("from");
+    const auto to = accepted.get<Vec2>("to");
     if (from && to && *from == *to) {
       r.invalid("to", "must differ from wall.from (a wall has a length)");
     }
-    set_if(wall.from, from);
-    set_if(wall.to, to);
-    set_if(wall.material, material_ref(r, "material", Need::kRequired));
-    set_if(wall.velocity, r.pair("velocity"));
     scene_.walls.push_back(std::move(wall));
   }
 
   void read_output(const toml::table& table) {
-    const TableReader r(diag_, table, "output", "[output]", "output", deck::kOutputKeys);
-    r.check_unknown_keys();
-    OutputSpec& output = scene_.output;
-    if (const auto directory = r.string("directory")) {
-      if (directory->empty()) {
-        r.invalid("directory", "must not be empty");
-      } else {
-        output.directory = *directory;
-      }
+    const TableReader r(diag_, table, deck::kOutput);
+    const OutputSpec& output = scene_.output;
+    const Accepted accepted = read_keys(r, deck::kOutput, scene_.output);
+    if (accepted.has("directory") && output.directory.empty()) {
+      r.invalid("directory", "must not be empty");
     }
-    set_if(output.series_interval, r.number("series_interval", kPositive));
-    set_if(output.snapshot_interval, r.number("snapshot_interval", kNonNegative));
-    if (const auto interval = r.number("checkpoint_interval", kNonNegative)) {
-      if (*interval > 0.0) {
-        r.invalid("checkpoint_interval", "checkpoints are not implemented yet; use 0");
-      }
+    if (accepted.has("checkpoint_interval") && output.checkpoint_interval > 0.0) {
+      r.invalid("checkpoint_interval", "checkpoints are not implemented yet; use 0");
     }
-    set_if(output.progress_interval, r.number("progress_interval", kPositive));
   }
 
   const toml::table& root_;

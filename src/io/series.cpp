@@ -5,26 +5,27 @@
 
 #include <cerrno>
 #include <cstring>
+#include <iterator>
+#include <type_traits>
 
 #include "core/errors.hpp"
 
 namespace dem2d {
 
 std::vector<std::string> series_columns(bool iterative) {
-  std::vector<std::string> columns{"time",
-                                   "step",
-                                   "particles",
-                                   "contacts",
-                                   "kinetic_energy",
-                                   "rotational_energy",
-                                   "potential_energy",
-                                   "elastic_energy",
-                                   "dissipated_energy",
-                                   "drum_torque",
-                                   "drum_power",
-                                   "drive_work"};
-  if (iterative) columns.emplace_back("passes");
+  std::vector<std::string> columns;
+  for (const SeriesColumn& column : kSeriesColumns) {
+    if (iterative || !column.iterative_only) columns.emplace_back(column.name);
+  }
   return columns;
+}
+
+std::string series_columns_markdown() {
+  std::string out = "| column | unit | meaning |\n| --- | --- | --- |\n";
+  for (const SeriesColumn& c : kSeriesColumns) {
+    out += fmt::format("| `{}` | {} | {} |\n", c.name, c.unit.empty() ? "–" : c.unit, c.doc);
+  }
+  return out;
 }
 
 SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active)
@@ -39,12 +40,20 @@ SeriesWriter::~SeriesWriter() = default;  // fclose flushes; its status cannot b
 
 void SeriesWriter::write(const SeriesRow& r) {
   if (!file_) return;
-  // {:.17g}: 17 significant digits, enough for any double to read back bit for bit.
-  std::string line = fmt::format(
-      "{:.17g},{},{},{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}", r.time,
-      r.step, r.particles, r.contacts, r.kinetic_energy, r.rotational_energy, r.potential_energy,
-      r.elastic_energy, r.dissipated_energy, r.drum_torque, r.drum_power, r.drive_work);
-  if (iterative_) line += fmt::format(",{:.17g}", r.passes);
+  std::string line;
+  const auto append = [&line](auto value) {
+    if constexpr (std::is_same_v<decltype(value), double>) {
+      // {:.17g}: 17 significant digits, enough for any double to read back bit for bit.
+      fmt::format_to(std::back_inserter(line), "{:.17g}", value);
+    } else {
+      fmt::format_to(std::back_inserter(line), "{}", value);
+    }
+  };
+  for (const SeriesColumn& column : kSeriesColumns) {
+    if (column.iterative_only && !iterative_) continue;
+    if (!line.empty()) line += ',';
+    std::visit([&](auto member) { append(r.*member); }, column.value);
+  }
   line += '\n';
   put(line);
 }

@@ -4,17 +4,24 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <numbers>
+#include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "io/deck.hpp"
+#include "io/deck_schema.hpp"
 #include "io/run_json.hpp"
+#include "io/text.hpp"
 
 namespace dem2d {
 namespace {
@@ -185,105 +192,45 @@ const std::string kPackingCsv =
     "# a comment line\n"
     "0.3, -0.1, 0.05, 0.0,\n";
 
+// Every key of one table of two scenes, compared through the deck's description
+// (deck_schema.hpp), so that a new key is compared without a line here. Values are compared in
+// the deck's units (degrees, "auto"), exactly.
+template <class T>
+void expect_same_keys(const deck::Table<T>& spec, const T& a, const T& b,
+                      const std::string& where) {
+  for (const deck::Key<T>& key : spec.keys) {
+    if (key.field.load == nullptr) continue;  // never written back (speed_rpm)
+    const std::optional<deck::Value> x = key.field.load(a);
+    const std::optional<deck::Value> y = key.field.load(b);
+    EXPECT_TRUE(x == y) << where << "." << key.name << ": " << (x ? deck::toml_text(*x) : "unset")
+                        << " vs " << (y ? deck::toml_text(*y) : "unset");
+  }
+}
+
+template <class T>
+void expect_same_keys(const deck::Table<T>& spec, const std::vector<T>& a, const std::vector<T>& b,
+                      const std::string& where) {
+  ASSERT_EQ(a.size(), b.size()) << where;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    expect_same_keys(spec, a[i], b[i], where + "[" + std::to_string(i) + "]");
+  }
+}
+
 // Every value of two scenes, except where they came from (deck_path, source lines).
 void expect_same_values(const Scene& a, const Scene& b) {
-  EXPECT_EQ(a.title, b.title);
-  EXPECT_EQ(a.run.duration, b.run.duration);
-  EXPECT_EQ(a.run.dt, b.run.dt);
-  EXPECT_EQ(a.run.dt_auto, b.run.dt_auto);
-  EXPECT_EQ(a.run.integrator, b.run.integrator);
-  EXPECT_EQ(a.run.tolerance, b.run.tolerance);
-  EXPECT_EQ(a.run.max_passes, b.run.max_passes);
-  EXPECT_EQ(a.run.seed, b.run.seed);
-  EXPECT_EQ(a.run.gravity, b.run.gravity);
-  EXPECT_EQ(a.run.skin, b.run.skin);
-  EXPECT_EQ(a.run.dt_safety, b.run.dt_safety);
-  EXPECT_EQ(a.run.allow_unsafe_dt, b.run.allow_unsafe_dt);
-  EXPECT_EQ(a.contact.model, b.contact.model);
-  EXPECT_EQ(a.contact.rolling, b.contact.rolling);
-  EXPECT_EQ(a.contact.rolling_damping, b.contact.rolling_damping);
-  ASSERT_EQ(a.materials.size(), b.materials.size());
-  for (std::size_t i = 0; i < a.materials.size(); ++i) {
-    const MaterialSpec &x = a.materials[i], &y = b.materials[i];
-    EXPECT_EQ(x.name, y.name);
-    EXPECT_EQ(x.density, y.density);
-    EXPECT_EQ(x.youngs_modulus, y.youngs_modulus);
-    EXPECT_EQ(x.poisson_ratio, y.poisson_ratio);
-    EXPECT_EQ(x.shear_modulus, y.shear_modulus);
-    EXPECT_EQ(x.restitution, y.restitution);
-    EXPECT_EQ(x.damping_normal, y.damping_normal);
-    EXPECT_EQ(x.damping_tangential, y.damping_tangential);
-    EXPECT_EQ(x.sliding_friction, y.sliding_friction);
-    EXPECT_EQ(x.rolling_friction, y.rolling_friction);
-    EXPECT_EQ(x.normal_stiffness, y.normal_stiffness);
-  }
-  ASSERT_EQ(a.interactions.size(), b.interactions.size());
-  for (std::size_t i = 0; i < a.interactions.size(); ++i) {
-    const InteractionSpec &x = a.interactions[i], &y = b.interactions[i];
-    EXPECT_EQ(x.material_a, y.material_a);
-    EXPECT_EQ(x.material_b, y.material_b);
-    EXPECT_EQ(x.restitution, y.restitution);
-    EXPECT_EQ(x.sliding_friction, y.sliding_friction);
-    EXPECT_EQ(x.rolling_friction, y.rolling_friction);
-    EXPECT_EQ(x.damping_normal, y.damping_normal);
-    EXPECT_EQ(x.damping_tangential, y.damping_tangential);
-  }
+  expect_same_keys(deck::kTopLevel, a, b, "");
+  expect_same_keys(deck::kRun, a.run, b.run, "run");
+  expect_same_keys(deck::kContact, a.contact, b.contact, "contact");
+  expect_same_keys(deck::kMaterial, a.materials, b.materials, "material");
+  expect_same_keys(deck::kInteraction, a.interactions, b.interactions, "interaction");
   EXPECT_EQ(a.drum.present, b.drum.present);
-  EXPECT_EQ(a.drum.radius, b.drum.radius);
-  EXPECT_EQ(a.drum.center, b.drum.center);
-  EXPECT_EQ(a.drum.speed, b.drum.speed);
-  EXPECT_EQ(a.drum.ramp_time, b.drum.ramp_time);
-  EXPECT_EQ(a.drum.sides, b.drum.sides);
-  EXPECT_EQ(a.drum.angle, b.drum.angle);
-  EXPECT_EQ(a.drum.material, b.drum.material);
-  ASSERT_EQ(a.drum.lifters.size(), b.drum.lifters.size());
-  for (std::size_t i = 0; i < a.drum.lifters.size(); ++i) {
-    const LifterSpec &x = a.drum.lifters[i], &y = b.drum.lifters[i];
-    EXPECT_EQ(x.count, y.count);
-    EXPECT_EQ(x.height, y.height);
-    EXPECT_EQ(x.width, y.width);
-    EXPECT_EQ(x.angle, y.angle);
-    EXPECT_EQ(x.material, y.material);
-  }
-  const auto same_fills = [](const std::vector<FillSpec>& fa, const std::vector<FillSpec>& fb) {
-    ASSERT_EQ(fa.size(), fb.size());
-    for (std::size_t i = 0; i < fa.size(); ++i) {
-      const FillSpec &x = fa[i], &y = fb[i];
-      EXPECT_EQ(x.material, y.material);
-      EXPECT_EQ(x.count, y.count);
-      EXPECT_EQ(x.fill_fraction, y.fill_fraction);
-      EXPECT_EQ(x.file, y.file);
-      EXPECT_EQ(x.radius_min, y.radius_min);
-      EXPECT_EQ(x.radius_max, y.radius_max);
-      EXPECT_EQ(x.region, y.region);
-      EXPECT_EQ(x.box_min, y.box_min);
-      EXPECT_EQ(x.box_max, y.box_max);
-      EXPECT_EQ(x.velocity, y.velocity);
-    }
-  };
-  same_fills(a.fills, b.fills);
-  same_fills(a.file_fills, b.file_fills);
-  ASSERT_EQ(a.particles.size(), b.particles.size());
-  for (std::size_t i = 0; i < a.particles.size(); ++i) {
-    const ParticleSpec &x = a.particles[i], &y = b.particles[i];
-    EXPECT_EQ(x.material, y.material);
-    EXPECT_EQ(x.radius, y.radius);
-    EXPECT_EQ(x.position, y.position);
-    EXPECT_EQ(x.velocity, y.velocity);
-    EXPECT_EQ(x.spin, y.spin);
-  }
-  ASSERT_EQ(a.walls.size(), b.walls.size());
-  for (std::size_t i = 0; i < a.walls.size(); ++i) {
-    EXPECT_EQ(a.walls[i].from, b.walls[i].from);
-    EXPECT_EQ(a.walls[i].to, b.walls[i].to);
-    EXPECT_EQ(a.walls[i].material, b.walls[i].material);
-    EXPECT_EQ(a.walls[i].velocity, b.walls[i].velocity);
-  }
-  EXPECT_EQ(a.output.directory, b.output.directory);
-  EXPECT_EQ(a.output.series_interval, b.output.series_interval);
-  EXPECT_EQ(a.output.snapshot_interval, b.output.snapshot_interval);
-  EXPECT_EQ(a.output.checkpoint_interval, b.output.checkpoint_interval);
-  EXPECT_EQ(a.output.progress_interval, b.output.progress_interval);
+  expect_same_keys(deck::kDrum, a.drum, b.drum, "drum");
+  expect_same_keys(deck::kLifter, a.drum.lifters, b.drum.lifters, "drum.lifter");
+  expect_same_keys(deck::kFill, a.fills, b.fills, "fill");
+  expect_same_keys(deck::kFill, a.file_fills, b.file_fills, "fill (file)");
+  expect_same_keys(deck::kParticle, a.particles, b.particles, "particle");
+  expect_same_keys(deck::kWall, a.walls, b.walls, "wall");
+  expect_same_keys(deck::kOutput, a.output, b.output, "output");
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1119,6 +1066,251 @@ TEST(DeckResolved, WritesEveryDefault) {
   }
   EXPECT_EQ(resolved.find("skin"), std::string::npos);  // unset: the core chooses
   EXPECT_EQ(resolved.find("[drum]"), std::string::npos);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The description itself (deck_schema.hpp)
+
+// The keys that code after the per-key pass reads, and those the resolved deck never writes.
+bool read_by_code(std::string_view path) {
+  return path == "drum.critical_fraction" || path == "fill.file";
+}
+bool never_written(std::string_view path) {
+  return path == "drum.speed_rpm" || path == "drum.critical_fraction";
+}
+
+std::string dotted(std::string_view table, std::string_view key) {
+  return table.empty() ? std::string(key) : std::string(table) + "." + std::string(key);
+}
+
+TEST(DeckDescription, TablesAndKeysAreConsistent) {
+  std::vector<std::pair<std::string, bool>> tables, named;  // path, repeated
+  deck::for_each_table([&](const auto& table) {
+    tables.emplace_back(std::string(table.path), table.repeated);
+    std::vector<std::string_view> seen;
+    for (const auto& key : table.keys) {
+      const std::string path = dotted(table.path, key.name);
+      SCOPED_TRACE(path);
+      EXPECT_EQ(std::count(seen.begin(), seen.end(), key.name), 0) << "named twice";
+      seen.push_back(key.name);
+      if (key.type == deck::Type::kTable || key.type == deck::Type::kTableArray) {
+        named.emplace_back(path, key.type == deck::Type::kTableArray);
+        continue;
+      }
+      EXPECT_EQ(key.type == deck::Type::kChoice, !key.choices.empty());
+      EXPECT_EQ(key.field.store == nullptr, read_by_code(path));
+      EXPECT_EQ(key.field.load == nullptr, never_written(path));
+      if (key.need == deck::Need::kRequired) {
+        EXPECT_TRUE(key.default_text.empty());
+      }
+    }
+  });
+  // Every sub-table key names a described table of its kind, and every table but the top
+  // level is named by one.
+  for (const auto& sub : named) {
+    EXPECT_NE(std::find(tables.begin(), tables.end(), sub), tables.end()) << sub.first;
+  }
+  for (const auto& table : tables) {
+    if (table.first.empty()) continue;
+    EXPECT_NE(std::find(named.begin(), named.end(), table), named.end()) << table.first;
+  }
+}
+
+// Values of the key's type inside its range, as a person types them (33.3, not
+// 30.299999999999997: an angle comes back as the shortest degrees that give the same radians).
+template <class T>
+std::vector<deck::Value> sample_values(const deck::Key<T>& key) {
+  const deck::Bound& b = key.range;
+  const double lo = std::isfinite(b.lo) ? b.lo : 0.0;
+  const double inside = std::isfinite(b.hi)   ? (lo + b.hi) / 2.0
+                        : std::isfinite(b.lo) ? lo + 2.5
+                                              : 33.3;
+  switch (key.type) {
+    case deck::Type::kNumber:
+      return {inside};
+    case deck::Type::kNumberOrAuto:
+      return {inside, std::string("auto")};
+    case deck::Type::kInteger:
+      return {static_cast<std::int64_t>(lo) + 2};
+    case deck::Type::kBool:
+      return {true, false};
+    case deck::Type::kChoice:
+      return {std::string(key.choices.front()), std::string(key.choices.back())};
+    case deck::Type::kVector:
+      return {Vec2{1.5, -2.5}};
+    case deck::Type::kMaterialPair:
+      return {deck::Names{"a", "b"}};
+    default:
+      return {std::string("steel")};
+  }
+}
+
+template <class T>
+void expect_fields_round_trip(const deck::Table<T>& table) {
+  for (const deck::Key<T>& key : table.keys) {
+    if (key.field.store == nullptr || key.field.load == nullptr) continue;
+    for (const deck::Value& value : sample_values(key)) {
+      T target{};
+      key.field.store(target, value);
+      const std::optional<deck::Value> back = key.field.load(target);
+      EXPECT_TRUE(back && *back == value)
+          << dotted(table.path, key.name) << ": stored " << deck::toml_text(value) << ", loaded "
+          << (back ? deck::toml_text(*back) : "nothing");
+    }
+  }
+}
+
+// Each key's field takes a value of the key's type and gives the same back, in the deck's units
+// (an angle in degrees, "auto"): a field of the wrong type would throw or drift here.
+TEST(DeckDescription, EveryFieldStoresAndLoadsItsType) {
+  deck::for_each_table([](const auto& table) { expect_fields_round_trip(table); });
+}
+
+// How --set names a key of a table's first element, and how messages name it.
+std::string set_path(std::string_view table, bool repeated, std::string_view key) {
+  if (table.empty()) return std::string(key);
+  return std::string(table) + (repeated ? ".0." : ".") + std::string(key);
+}
+std::string message_path(std::string_view table, bool repeated, std::string_view key) {
+  if (table.empty()) return std::string(key);
+  return std::string(table) + (repeated ? "[0]." : ".") + std::string(key);
+}
+
+// One override and the message it must cause.
+struct Case {
+  std::string option;
+  std::string message;
+};
+
+// The case for one key, or none (make_case returns an empty option).
+using MakeCase = std::function<Case(
+    std::string_view table, bool repeated, std::string_view key, deck::Type, const deck::Bound&,
+    std::int64_t max, std::span<const std::string_view> choices, std::string_view unit)>;
+
+// A case for every key that `model` takes and no other model's pass covers: the keys of all
+// models with "hertz-mindlin" (kFullDeck's), a model's own coefficients with that model.
+template <class T>
+void add_cases(const deck::Table<T>& table, ContactModelKind model, const MakeCase& make_case,
+               std::vector<Case>& cases) {
+  for (const deck::Key<T>& key : table.keys) {
+    if (key.type == deck::Type::kTable || key.type == deck::Type::kTableArray) continue;
+    if (!deck::takes(key.models, model)) continue;
+    if (model != ContactModelKind::kHertzMindlin && key.models == deck::kAllModels) continue;
+    Case c = make_case(table.path, table.repeated, key.name, key.type, key.range, key.max,
+                       key.choices, key.unit);
+    if (!c.option.empty()) cases.push_back(std::move(c));
+  }
+}
+
+// Loads kFullDeck under each contact model with every case's override at once and expects
+// every case's message; returns the number of cases.
+std::size_t expect_cases(const MakeCase& make_case) {
+  const TempDir dir;
+  dir.write("packing.csv", kPackingCsv);
+  const fs::path deck = dir.write("full.in", kFullDeck);
+  std::size_t count = 0;
+  for (const auto& model : deck::kContactModels) {
+    std::vector<Case> cases;
+    deck::for_each_table(
+        [&](const auto& table) { add_cases(table, model.value, make_case, cases); });
+    std::vector<std::string> options{"contact.model=" + std::string(model.name)};
+    for (const Case& c : cases) options.push_back(c.option);
+    std::vector<std::string> messages;
+    try {
+      load_deck(deck.string(), options);
+      ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+      messages = e.messages();
+    }
+    for (const Case& c : cases) EXPECT_TRUE(has_message(messages, c.message)) << model.name;
+    count += cases.size();
+  }
+  return count;
+}
+
+// "--set material.0.density=0.0: error: material[0].density = 0.0: must be > 0".
+Case make_case(std::string_view table, bool repeated, std::string_view key,
+               const std::string& value, const std::string& shown, const std::string& what) {
+  const std::string where = set_path(table, repeated, key) + "=" + value;
+  return {where, "--set " + where + ": error: " + message_path(table, repeated, key) + " = " +
+                     shown + ": " + what};
+}
+
+// A bounded number or integer key set just below (upper: above) its range.
+Case out_of_range(bool upper, std::string_view table, bool repeated, std::string_view key,
+                  deck::Type type, const deck::Bound& b, std::int64_t max) {
+  const bool integer = type == deck::Type::kInteger;
+  if ((type != deck::Type::kNumber && !integer) || b.unbounded()) return {};
+  std::string value;
+  if (!upper && std::isfinite(b.lo)) {
+    value = integer ? std::to_string(static_cast<std::int64_t>(b.lo) - 1)
+                    : toml_number(b.lo_open ? b.lo : b.lo - 1.0);
+  } else if (upper && std::isfinite(b.hi)) {
+    value = toml_number(b.hi_open ? b.hi : b.hi + 1.0);
+  } else if (upper && integer && max < INT_MAX) {
+    value = std::to_string(max + 1);
+    return make_case(table, repeated, key, value, value, "must be <= " + std::to_string(max));
+  } else {
+    return {};
+  }
+  return make_case(table, repeated, key, value, value, "must be " + b.text());
+}
+
+// The per-key pass checks every described range, from below and from above.
+TEST(DeckDescription, EveryRangeIsChecked) {
+  std::size_t count = 0;
+  for (const bool upper : {false, true}) {
+    count += expect_cases([upper](std::string_view table, bool repeated, std::string_view key,
+                                  deck::Type type, const deck::Bound& b, std::int64_t max,
+                                  std::span<const std::string_view>, std::string_view) {
+      return out_of_range(upper, table, repeated, key, type, b, max);
+    });
+  }
+  EXPECT_GE(count, 50u);  // 50 when written: not none by mistake
+}
+
+// A key set to a value of another type, and the message, written here by hand from the type.
+Case wrong_type(std::string_view table, bool repeated, std::string_view key, deck::Type type,
+                const deck::Bound& b, std::span<const std::string_view> choices,
+                std::string_view unit) {
+  const std::string range = b.unbounded() ? "" : " " + b.text();
+  switch (type) {
+    case deck::Type::kNumber:
+      return make_case(table, repeated, key, "'x'", "\"x\"", "expected a number" + range);
+    case deck::Type::kInteger:
+      return make_case(table, repeated, key, "2.5", "2.5", "expected an integer" + range);
+    case deck::Type::kBool:
+      return make_case(table, repeated, key, "2.5", "2.5", "expected true or false");
+    case deck::Type::kChoice: {
+      std::string words;
+      for (const std::string_view w : choices) {
+        words += (words.empty() ? "\"" : ", \"") + std::string(w) + "\"";
+      }
+      return make_case(table, repeated, key, "2.5", "2.5", "expected a string, one of " + words);
+    }
+    case deck::Type::kVector:
+      return make_case(table, repeated, key, "2.5", "2.5",
+                       "expected an array of two numbers [x, y]");
+    case deck::Type::kNumberOrAuto:
+      return make_case(table, repeated, key, "true", "true",
+                       "expected a number" + range + " (" + std::string(unit) + ") or \"auto\"");
+    case deck::Type::kMaterialPair:
+      return make_case(table, repeated, key, "2.5", "2.5",
+                       "expected two material names [\"a\", \"b\"]");
+    default:  // kString, kMaterial
+      return make_case(table, repeated, key, "2.5", "2.5", "expected a string");
+  }
+}
+
+// The per-key pass checks every described key's type.
+TEST(DeckDescription, EveryTypeIsChecked) {
+  const std::size_t count =
+      expect_cases([](std::string_view table, bool repeated, std::string_view key, deck::Type type,
+                      const deck::Bound& b, std::int64_t, std::span<const std::string_view> choices,
+                      std::string_view unit) {
+        return wrong_type(table, repeated, key, type, b, choices, unit);
+      });
+  EXPECT_GE(count, 74u);  // every key of every table (74 when written)
 }
 
 TEST(RunJson, HoldsTheRunAndTheResolvedDeck) {
