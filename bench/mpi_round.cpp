@@ -1,7 +1,8 @@
 // mpi_round: what one synchronisation costs between two ranks on this machine, the floor under
 // a parallel step (issue 3: why the 240-ball waterfall cannot run in half the time on 2 ranks).
 //
-//   OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np 2 build/bench/mpi_round [--results DIR]
+//   OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np 2 build/bench/mpi_round
+//   [--results DIR]
 //
 // Times, per iteration, the exchanges a step of dem2d can make: the end-of-step round of
 // velocity Verlet (640 bytes each way: 15 ghosts' next state and the reduction), the same
@@ -74,7 +75,8 @@ int main(int argc, char** argv) {
     MPI_Startall(2, persistent);
     MPI_Waitall(2, persistent, MPI_STATUSES_IGNORE);
   });
-  time("MPI_Allreduce max, 2 doubles", [&]() { MPI_Allreduce(values, reduced, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD); });
+  time("MPI_Allreduce max, 2 doubles",
+       [&]() { MPI_Allreduce(values, reduced, 2, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD); });
   time("1.5 us of work alone", [&]() { work_for(busy); });
   time("1.5 us of work, then the round", [&]() {
     work_for(busy);

@@ -240,7 +240,8 @@ inline Packing settle_packing(std::int64_t n) {
     for (std::size_t k = 0; k < out.pos.size(); ++k)
       store.pos[k] = out.pos[static_cast<std::size_t>(store.id[k])];
     sim.rebuild();
-    std::vector<std::int32_t> pi(sim.pairs().i.begin(), sim.pairs().i.end()), pj(sim.pairs().j.begin(), sim.pairs().j.end());
+    std::vector<std::int32_t> pi(sim.pairs().i.begin(), sim.pairs().i.end()),
+        pj(sim.pairs().j.begin(), sim.pairs().j.end());
     for (auto& v : pi) v = static_cast<std::int32_t>(store.id[static_cast<std::size_t>(v)]);
     for (auto& v : pj) v = static_cast<std::int32_t>(store.id[static_cast<std::size_t>(v)]);
     relaxed = relax_overlaps(out.pos, out.radius, radius, pi, pj, 0.25 * sim.skin(), worst);

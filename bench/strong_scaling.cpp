@@ -1,6 +1,7 @@
 // strong_scaling: the same scenes at 1 and 2 ranks (issue 3).
 //
-//   build/bench/strong_scaling [--ranks 1,2] [--steps S] [--repeats R] [--waterfall-time T] [--no-plot]
+//   build/bench/strong_scaling [--ranks 1,2] [--steps S] [--repeats R] [--waterfall-time T]
+//   [--no-plot]
 //                              [--results DIR]
 //
 // Run without --worker, the program starts itself under `mpirun -np P --worker` for each P and
@@ -30,10 +31,10 @@
 #include <string>
 #include <vector>
 
-#include "settled_drum.hpp"
 #include "core/simulation.hpp"
 #include "io/deck.hpp"
 #include "parallel/mpi_domain.hpp"
+#include "settled_drum.hpp"
 
 namespace {
 
@@ -59,8 +60,8 @@ struct Row {
   int partitions = 0;
 };
 
-Row measure(const std::string& name, const Scene& scene, int untimed, std::int64_t steps, int repeats,
-            MPI_Comm comm) {
+Row measure(const std::string& name, const Scene& scene, int untimed, std::int64_t steps,
+            int repeats, MPI_Comm comm) {
   int rank = 0, size = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &size);
@@ -112,9 +113,10 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
 
 std::string csv(const Row& r) {
   char buf[512];
-  std::snprintf(buf, sizeof buf, "%s,%d,%lld,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%lld,%d", r.scene.c_str(), r.ranks,
-                static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, r.compute, r.imbalance,
-                r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), r.partitions);
+  std::snprintf(buf, sizeof buf, "%s,%d,%lld,%lld,%.6g,%.6g,%.6g,%.6g,%.6g,%lld,%d",
+                r.scene.c_str(), r.ranks, static_cast<long long>(r.particles),
+                static_cast<long long>(r.steps), r.wall, r.compute, r.imbalance, r.halo_fraction,
+                r.comm_share, static_cast<long long>(r.migrated), r.partitions);
   return buf;
 }
 
@@ -125,11 +127,14 @@ int worker(const Args& a) {
   std::vector<Row> rows;
   {
     const bench::Packing pk = bench::settled_packing(30000, a.results + "/cache", false);
-    if (pk.from_cache) rows.push_back(measure("drum30k", bench::settled_scene(pk, 1e-6), 300, a.steps, a.repeats, MPI_COMM_WORLD));
+    if (pk.from_cache)
+      rows.push_back(measure("drum30k", bench::settled_scene(pk, 1e-6), 300, a.steps, a.repeats,
+                             MPI_COMM_WORLD));
   }
   {
     Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall.in");
-    rows.push_back(measure("waterfall", s, 0, static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), a.repeats,
+    rows.push_back(measure("waterfall", s, 0,
+                           static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), a.repeats,
                            MPI_COMM_WORLD));
   }
   if (rank == 0) {
@@ -147,19 +152,28 @@ int main(int argc, char** argv) {
   for (int k = 1; k < argc; ++k) {
     const std::string s = argv[k];
     const auto next = [&]() -> std::string { return k + 1 < argc ? argv[++k] : ""; };
-    if (s == "--worker") a.worker = true;
-    else if (s == "--rows") a.rows = next();
-    else if (s == "--steps") a.steps = std::atoi(next().c_str());
-    else if (s == "--repeats") a.repeats = std::max(1, std::atoi(next().c_str()));
-    else if (s == "--waterfall-time") a.waterfall_time = std::atof(next().c_str());
-    else if (s == "--no-plot") a.plot = false;
-    else if (s == "--results") a.results = next();
+    if (s == "--worker")
+      a.worker = true;
+    else if (s == "--rows")
+      a.rows = next();
+    else if (s == "--steps")
+      a.steps = std::atoi(next().c_str());
+    else if (s == "--repeats")
+      a.repeats = std::max(1, std::atoi(next().c_str()));
+    else if (s == "--waterfall-time")
+      a.waterfall_time = std::atof(next().c_str());
+    else if (s == "--no-plot")
+      a.plot = false;
+    else if (s == "--results")
+      a.results = next();
     else if (s == "--ranks") {
       a.ranks.clear();
       std::stringstream ls(next());
       for (std::string t; std::getline(ls, t, ',');) a.ranks.push_back(std::atoi(t.c_str()));
     } else {
-      std::fprintf(stderr, "usage: strong_scaling [--ranks 1,2] [--steps S] [--repeats R] [--waterfall-time T] [--no-plot] [--results DIR]\n");
+      std::fprintf(stderr,
+                   "usage: strong_scaling [--ranks 1,2] [--steps S] [--repeats R] "
+                   "[--waterfall-time T] [--no-plot] [--results DIR]\n");
       return 2;
     }
   }
@@ -167,13 +181,15 @@ int main(int argc, char** argv) {
 
   const std::string rows_path = a.results + "/strong_scaling.rows.tmp";
   std::remove(rows_path.c_str());
-  std::printf("== strong_scaling: drum30k (30 000 spheres, dt 1e-6, %d steps) and waterfall (%.3g s)\n", a.steps,
-              a.waterfall_time);
+  std::printf(
+      "== strong_scaling: drum30k (30 000 spheres, dt 1e-6, %d steps) and waterfall (%.3g s)\n",
+      a.steps, a.waterfall_time);
   for (int np : a.ranks) {
     std::ostringstream cmd;
-    cmd << "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np " << np << " --oversubscribe '"
-        << argv[0] << "' --worker --rows '" << rows_path << "' --steps " << a.steps << " --repeats " << a.repeats << " --waterfall-time "
-        << a.waterfall_time << " --results '" << a.results << "'";
+    cmd << "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np " << np
+        << " --oversubscribe '" << argv[0] << "' --worker --rows '" << rows_path << "' --steps "
+        << a.steps << " --repeats " << a.repeats << " --waterfall-time " << a.waterfall_time
+        << " --results '" << a.results << "'";
     std::printf("$ %s\n", cmd.str().c_str());
     std::fflush(stdout);
     if (std::system(cmd.str().c_str()) != 0) {
@@ -190,8 +206,8 @@ int main(int argc, char** argv) {
     std::getline(ls, r.scene, ',');
     char c;
     long long p, st, mg;
-    ls >> r.ranks >> c >> p >> c >> st >> c >> r.wall >> c >> r.compute >> c >> r.imbalance >> c >> r.halo_fraction >> c >>
-        r.comm_share >> c >> mg >> c >> r.partitions;
+    ls >> r.ranks >> c >> p >> c >> st >> c >> r.wall >> c >> r.compute >> c >> r.imbalance >> c >>
+        r.halo_fraction >> c >> r.comm_share >> c >> mg >> c >> r.partitions;
     r.particles = p;
     r.steps = st;
     r.migrated = mg;
@@ -200,10 +216,12 @@ int main(int argc, char** argv) {
   std::remove(rows_path.c_str());
   const std::string out_csv = a.results + "/strong_scaling.csv";
   std::ofstream out(out_csv);
-  out << "scene,ranks,particles,steps,wall,speedup,efficiency,imbalance,halo_fraction,comm_share,migrated,partitions,"
+  out << "scene,ranks,particles,steps,wall,speedup,efficiency,imbalance,halo_fraction,comm_share,"
+         "migrated,partitions,"
          "particle_steps_per_s,us_per_step,ceiling\n";
-  std::printf("\n%-10s %5s %9s %7s %9s %8s %6s %9s %6s %6s %9s %12s %8s %8s\n", "scene", "ranks", "particles", "steps",
-              "wall (s)", "speedup", "eff.", "imbalance", "halo", "comm", "migrated", "p-steps/s", "us/step", "ceiling");
+  std::printf("\n%-10s %5s %9s %7s %9s %8s %6s %9s %6s %6s %9s %12s %8s %8s\n", "scene", "ranks",
+              "particles", "steps", "wall (s)", "speedup", "eff.", "imbalance", "halo", "comm",
+              "migrated", "p-steps/s", "us/step", "ceiling");
   for (const Row& r : rows) {
     double base = r.wall;
     for (const Row& q : rows)
@@ -212,19 +230,22 @@ int main(int argc, char** argv) {
     const double rate = static_cast<double>(r.particles) * r.steps / r.wall;
     const double us_per_step = 1e6 * r.wall / static_cast<double>(r.steps);
     const double ceiling = r.compute > 0.0 ? base / r.compute : 0.0;
-    std::printf("%-10s %5d %9lld %7lld %9.3f %8.2f %6.2f %9.3f %6.3f %6.3f %9lld %12.3g %8.2f %8.2f\n", r.scene.c_str(),
-                r.ranks, static_cast<long long>(r.particles), static_cast<long long>(r.steps), r.wall, speedup, eff,
-                r.imbalance, r.halo_fraction, r.comm_share, static_cast<long long>(r.migrated), rate, us_per_step,
-                ceiling);
-    out << r.scene << "," << r.ranks << "," << r.particles << "," << r.steps << "," << r.wall << "," << speedup << ","
-        << eff << "," << r.imbalance << "," << r.halo_fraction << "," << r.comm_share << "," << r.migrated << ","
-        << r.partitions << "," << rate << "," << us_per_step << "," << ceiling << "\n";
+    std::printf(
+        "%-10s %5d %9lld %7lld %9.3f %8.2f %6.2f %9.3f %6.3f %6.3f %9lld %12.3g %8.2f %8.2f\n",
+        r.scene.c_str(), r.ranks, static_cast<long long>(r.particles),
+        static_cast<long long>(r.steps), r.wall, speedup, eff, r.imbalance, r.halo_fraction,
+        r.comm_share, static_cast<long long>(r.migrated), rate, us_per_step, ceiling);
+    out << r.scene << "," << r.ranks << "," << r.particles << "," << r.steps << "," << r.wall << ","
+        << speedup << "," << eff << "," << r.imbalance << "," << r.halo_fraction << ","
+        << r.comm_share << "," << r.migrated << "," << r.partitions << "," << rate << ","
+        << us_per_step << "," << ceiling << "\n";
   }
   out.close();
   std::printf("wrote %s\n", out_csv.c_str());
   if (a.plot) {
-    const std::string cmd = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) + "/post/plot_strong_scaling.py' '" +
-                            out_csv + "' -o '" + a.results + "/strong_scaling.png'";
+    const std::string cmd = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) +
+                            "/post/plot_strong_scaling.py' '" + out_csv + "' -o '" + a.results +
+                            "/strong_scaling.png'";
     if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "strong_scaling: the plot failed\n");
   }
   return 0;

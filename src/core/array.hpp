@@ -7,8 +7,9 @@
 // page: element j of every column then falls into the same L1 cache set (4 KiB apart), more
 // columns than the cache has ways evict each other, and loads and stores alias in the 4 KiB
 // store-forwarding check. Measured on the 30 000-sphere scene: 85 ns per particle-step with
-// page-aligned columns against 48 ns with the columns spread (bench/throughput, docs/performance.md).
-// Each allocation here starts a different number of cache lines (1..63) into its first page.
+// page-aligned columns against 48 ns with the columns spread (bench/throughput,
+// docs/performance.md). Each allocation here starts a different number of cache lines (1..63) into
+// its first page.
 #pragma once
 
 #include <atomic>
@@ -37,17 +38,18 @@ struct StaggeredAllocator {
   StaggeredAllocator(const StaggeredAllocator<U>&) noexcept {}
 
   T* allocate(std::size_t n) {
-    if (n > (static_cast<std::size_t>(-1) - detail::kPage) / sizeof(T)) throw std::bad_array_new_length();
+    if (n > (static_cast<std::size_t>(-1) - detail::kPage) / sizeof(T))
+      throw std::bad_array_new_length();
     const std::size_t offset = detail::next_stagger() * detail::kLine;
     std::byte* base = static_cast<std::byte*>(
-        ::operator new(n * sizeof(T) + detail::kPage, std::align_val_t{detail::kLine}));
+        ::operator new (n * sizeof(T) + detail::kPage, std::align_val_t{detail::kLine}));
     std::byte* p = base + offset;
     reinterpret_cast<std::byte**>(p)[-1] = base;  // offset >= 64: room for the base pointer
     return reinterpret_cast<T*>(p);
   }
   void deallocate(T* p, std::size_t) noexcept {
     std::byte* base = reinterpret_cast<std::byte**>(p)[-1];
-    ::operator delete(base, std::align_val_t{detail::kLine});
+    ::operator delete (base, std::align_val_t{detail::kLine});
   }
   friend bool operator==(const StaggeredAllocator&, const StaggeredAllocator&) { return true; }
 };

@@ -37,15 +37,15 @@ struct ContactBatch {
   Array<double> dx, dy;       // x_j - x_i
   Array<double> dist2;        // |x_j - x_i|^2
   Array<double> r_i, r_j, m_i, m_j;
-  Array<double> vx, vy;       // v_i - v_j
-  Array<double> spin;         // w_i r_i + w_j r_j
-  Array<double> omega_rel;    // w_i - w_j
-  Array<double> counted;      // 1: this rank books the contact's energies and count, 0: not
+  Array<double> vx, vy;     // v_i - v_j
+  Array<double> spin;       // w_i r_i + w_j r_j
+  Array<double> omega_rel;  // w_i - w_j
+  Array<double> counted;    // 1: this rank books the contact's energies and count, 0: not
   HistoryColumns history;
   // Outputs (phase B).
-  Array<double> fx, fy;       // force on i (on j: the opposite)
-  Array<double> t_i, t_j;     // torques on i and on j
-  Array<double> overlap;      // delta / min(r_i, r_j)
+  Array<double> fx, fy;    // force on i (on j: the opposite)
+  Array<double> t_i, t_j;  // torques on i and on j
+  Array<double> overlap;   // delta / min(r_i, r_j)
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
@@ -64,8 +64,22 @@ struct ContactBatch {
 
  private:
   std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
-    return {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel, &counted,
-            &history.old[0], &history.old[1], &history.old[2], &history.old[3]};
+    return {&dx,
+            &dy,
+            &dist2,
+            &r_i,
+            &r_j,
+            &m_i,
+            &m_j,
+            &vx,
+            &vy,
+            &spin,
+            &omega_rel,
+            &counted,
+            &history.old[0],
+            &history.old[1],
+            &history.old[2],
+            &history.old[3]};
   }
 };
 
@@ -74,14 +88,14 @@ struct ContactBatch {
 // and the scatter adds forces, energies, drive power and drum torque in wall-list order.
 struct WallBatch {
   // Inputs (phase A).
-  Array<std::int32_t> pair;   // index into the wall pair list
-  Array<std::int32_t> coeff;  // material pair index into the coefficient table
+  Array<std::int32_t> pair;     // index into the wall pair list
+  Array<std::int32_t> coeff;    // material pair index into the coefficient table
   Array<double> delta, nx, ny;  // overlap; unit normal from the sphere towards the wall
   Array<double> r, m;
-  Array<double> vx, vy;       // v_rel = (v_i - v_wall) + w_i r_i t
-  Array<double> omega_rel;    // w_i - Omega_wall
-  Array<double> wx, wy;       // wall velocity at the contact point
-  Array<double> px, py;       // contact point
+  Array<double> vx, vy;     // v_rel = (v_i - v_wall) + w_i r_i t
+  Array<double> omega_rel;  // w_i - Omega_wall
+  Array<double> wx, wy;     // wall velocity at the contact point
+  Array<double> px, py;     // contact point
   HistoryColumns history;
   // Outputs (phase B).
   Array<double> fx, fy, torque, m_roll;
@@ -90,7 +104,8 @@ struct WallBatch {
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
     for (auto* v : inputs()) v->resize(n);
-    for (auto* v : {&wx, &wy, &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll})
+    for (auto* v :
+         {&wx, &wy, &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll})
       v->resize(n);
     for (auto& v : history.fresh) v.resize(n);
     pair.resize(n);
@@ -105,8 +120,18 @@ struct WallBatch {
  private:
   // What phase B reads (copied into the padding lanes).
   std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
-    return {&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel,
-            &history.old[0], &history.old[1], &history.old[2], &history.old[3]};
+    return {&delta,
+            &nx,
+            &ny,
+            &r,
+            &m,
+            &vx,
+            &vy,
+            &omega_rel,
+            &history.old[0],
+            &history.old[1],
+            &history.old[2],
+            &history.old[3]};
   }
 };
 

@@ -29,8 +29,8 @@ template <class T>
 // A contact's history between the batch columns (slot by slot, law first) and the model's
 // History<Pack>.
 template <class Model>
-[[gnu::always_inline]] inline typename Model::template History<Pack> load_history(const HistoryColumns& h,
-                                                                                  std::size_t c) {
+[[gnu::always_inline]] inline typename Model::template History<Pack> load_history(
+    const HistoryColumns& h, std::size_t c) {
   typename Model::template History<Pack> out;
   std::size_t s = 0;
   for (Pack& v : out.law) v = load(h.old[s++], c);
@@ -39,8 +39,8 @@ template <class Model>
   return out;
 }
 template <class Model>
-[[gnu::always_inline]] inline void store_history(const typename Model::template History<Pack>& in, HistoryColumns& h,
-                                                 std::size_t c) {
+[[gnu::always_inline]] inline void store_history(const typename Model::template History<Pack>& in,
+                                                 HistoryColumns& h, std::size_t c) {
   std::size_t s = 0;
   for (const Pack& v : in.law) store(v, h.fresh[s++], c);
   for (const Pack& v : in.rolling) store(v, h.fresh[s++], c);
@@ -77,7 +77,9 @@ class Kernel final : public ContactKernel {
   }
 
  private:
-  typename Model::template Coeffs<Pack> broadcast(std::int32_t k) const { return Model::broadcast(coeffs_[k]); }
+  typename Model::template Coeffs<Pack> broadcast(std::int32_t k) const {
+    return Model::broadcast(coeffs_[k]);
+  }
   template <class Index>
   [[gnu::always_inline]] typename Model::template Coeffs<Pack> coeffs_of(Index index) const {
     if (n_mat_ == 1) return uniform_;
@@ -88,10 +90,12 @@ class Kernel final : public ContactKernel {
   std::size_t gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1);
   void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
-  void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt, EvaluationTotals& tot);
+  void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
+                     EvaluationTotals& tot);
   std::size_t gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl);
   void evaluate_walls(std::size_t n, double dt);
-  void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n, EvaluationTotals& tot);
+  void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
+                     EvaluationTotals& tot);
 
   int n_mat_;
   std::vector<Coeffs> coeffs_;  // [a * n_mat_ + b]
@@ -106,7 +110,8 @@ class Kernel final : public ContactKernel {
 // through memory: 1.7x slower per particle-step at 1e5 particles). Chunks run in list order, so
 // the scatter stays canonical.
 template <class Model>
-void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt, EvaluationTotals& tot) {
+void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
+                                  EvaluationTotals& tot) {
   constexpr std::size_t kChunk = 512;
   b_.reserve(kChunk + kPackSize);
   Pack dissipated(0.0), elastic(0.0);
@@ -139,7 +144,8 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt, Eva
 // Branch-free compaction: every candidate is written to slot n and n advances only for a
 // contact (whether a candidate touches is close to random, so a branch here mispredicts often).
 template <class Model>
-std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1) {
+std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
+                                        std::size_t k1) {
   const Vec2* x = p.pos.data();
   const double* r = p.radius.data();
   double* trial = pl.trial.data();
@@ -178,7 +184,8 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
     b_.vy[c] = v[i].y - v[j].y;
     b_.spin[c] = w[i] * r[i] + w[j] * r[j];
     b_.omega_rel[c] = w[i] - w[j];
-    for (std::size_t s = 0; s < W; ++s) b_.history.old[s][c] = hist[static_cast<std::size_t>(k) * W + s];
+    for (std::size_t s = 0; s < W; ++s)
+      b_.history.old[s][c] = hist[static_cast<std::size_t>(k) * W + s];
   }
   for (std::size_t c = n; c < padded(n); ++c) b_.copy(c, n - 1);
   return n;
@@ -186,7 +193,8 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
 
 // B. The contact model on packs of kPackSize contacts.
 template <class Model>
-void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap) {
+void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic,
+                                   Pack& overlap) {
   for (std::size_t c = 0; c < padded(n); c += kPackSize) {
     const Pack dist = vsqrt(load(b_.dist2, c));
     const Pack inv = 1.0 / dist;
@@ -209,7 +217,8 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     kin.omega_rel = load(b_.omega_rel, c);
     typename Model::template History<Pack> h;
     const auto pc = coeffs_of([&](auto l) { return b_.coeff[c + l]; });
-    const ContactResponseT<Pack> out = Model::evaluate(pc, kin, load_history<Model>(b_.history, c), h, dt);
+    const ContactResponseT<Pack> out =
+        Model::evaluate(pc, kin, load_history<Model>(b_.history, c), h, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
     const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : ri;
@@ -225,7 +234,8 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     const Pack ratio = kin.delta / vmin(ri, rj);
     // Padding lanes repeat the last contact: keep them out of the sums.
     const PackMask real =
-        Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) && load(b_.counted, c) > 0.5;
+        Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
+        load(b_.counted, c) > 0.5;
     dissipated += select(real, diss, Pack(0.0));
     elastic += select(real, el, Pack(0.0));
     overlap = vmax(overlap, ratio);
@@ -252,7 +262,8 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
     f[j] -= fi;
     tq[i] += b_.t_i[c];
     tq[j] += b_.t_j[c];
-    for (std::size_t s = 0; s < W; ++s) trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
+    for (std::size_t s = 0; s < W; ++s)
+      trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
   }
 }
 
@@ -269,7 +280,8 @@ void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPair
 }
 
 template <class Model>
-std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl) {
+std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& walls,
+                                        WallPairList& wl) {
   const Vec2* x = p.pos.data();
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
@@ -324,7 +336,8 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     kin.omega_rel = load(wb_.omega_rel, c);
     typename Model::template History<Pack> h;
     const auto pc = coeffs_of([&](auto l) { return wb_.coeff[c + l]; });
-    const ContactResponseT<Pack> out = Model::evaluate(pc, kin, load_history<Model>(wb_.history, c), h, dt);
+    const ContactResponseT<Pack> out =
+        Model::evaluate(pc, kin, load_history<Model>(wb_.history, c), h, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
     Pack ti = ri * cf.f_t;
@@ -342,8 +355,8 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
 }
 
 template <class Model>
-void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
-                                  EvaluationTotals& tot) {
+void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl,
+                                  std::size_t n, EvaluationTotals& tot) {
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   const WallElement* elements = walls.elements().data();
@@ -365,10 +378,12 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
       dissipated += wb_.diss_roll[c];
       elastic += wb_.el_roll[c];
     }
-    for (std::size_t s = 0; s < W; ++s) wl.trial[static_cast<std::size_t>(k) * W + s] = wb_.history.fresh[s][c];
+    for (std::size_t s = 0; s < W; ++s)
+      wl.trial[static_cast<std::size_t>(k) * W + s] = wb_.history.fresh[s][c];
     // Power the wall's drive puts into the particles: F . v_wall + M Omega (the reaction couple).
     tot.drive_power += dot(fi, Vec2{wb_.wx[c], wb_.wy[c]}) + m_roll * bodies[e.body].omega;
-    if (e.body == drum) tot.drum_torque += cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
+    if (e.body == drum)
+      tot.drum_torque += cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
     const double ratio = wb_.delta[c] / wb_.r[c];
     if (ratio > max_ratio) {
       max_ratio = ratio;
@@ -387,7 +402,8 @@ template <class Registry, class Kind, class F>
 std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
   return [&]<class... Models>(std::type_identity<std::tuple<Models...>>) {
     std::unique_ptr<ContactKernel> out;
-    static_cast<void>(((Models::kKind == kind ? (out = f(std::type_identity<Models>{}), true) : false) || ...));
+    static_cast<void>(
+        ((Models::kKind == kind ? (out = f(std::type_identity<Models>{}), true) : false) || ...));
     return out;
   }(std::type_identity<Registry>{});
 }
@@ -395,12 +411,14 @@ std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
 }  // namespace
 
 // The model is chosen here, once: one kernel per (law, rolling model, tracker).
-std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table) {
+std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec,
+                                                   const PairTable& table) {
   return pick<ContactLaws>(spec.model, [&](auto law) {
     return pick<RollingModels>(spec.rolling, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
       using Law = typename decltype(law)::type;
       using Rolling = typename decltype(rolling)::type;
-      if (spec.track_peak_energy) return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackPeakEnergy>>>(spec, table);
+      if (spec.track_peak_energy)
+        return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackPeakEnergy>>>(spec, table);
       return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackNone>>>(spec, table);
     });
   });
@@ -427,9 +445,12 @@ void ContactEngine::commit() {
 HistoryRecords ContactEngine::records() const {
   const std::size_t width = pairs_.width;
   HistoryRecords out(width);
-  const auto live = [&](const double* h) { return std::any_of(h, h + width, [](double v) { return v != 0.0; }); };
+  const auto live = [&](const double* h) {
+    return std::any_of(h, h + width, [](double v) { return v != 0.0; });
+  };
   for (std::size_t k = 0; k < pairs_.size(); ++k)
-    if (live(pairs_.history_of(k))) out.push_back(pairs_.id_i[k], pairs_.id_j[k], pairs_.history_of(k));
+    if (live(pairs_.history_of(k)))
+      out.push_back(pairs_.id_i[k], pairs_.id_j[k], pairs_.history_of(k));
   for (std::size_t k = 0; k < wall_pairs_.size(); ++k)
     if (live(wall_pairs_.history_of(k)))
       out.push_back(wall_pairs_.id[k], -1 - static_cast<std::int64_t>(wall_pairs_.element[k]),

@@ -32,11 +32,11 @@ inline constexpr double kMaxOverlapRatio = 0.25;
 // What one force evaluation adds up on this rank.
 struct EvaluationTotals {
   std::int64_t contacts = 0;
-  double dissipated = 0.0;   // J in this step
-  double elastic = 0.0;      // J stored in all contacts
-  double drum_torque = 0.0;  // N m applied by the drive
-  double drive_power = 0.0;  // W delivered by moving walls
-  double max_overlap = 0.0;  // largest delta / min(r_i, r_j)
+  double dissipated = 0.0;                  // J in this step
+  double elastic = 0.0;                     // J stored in all contacts
+  double drum_torque = 0.0;                 // N m applied by the drive
+  double drive_power = 0.0;                 // W delivered by moving walls
+  double max_overlap = 0.0;                 // largest delta / min(r_i, r_j)
   std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)
 };
 
@@ -47,8 +47,8 @@ class ContactKernel {
   virtual std::span<const HistorySlot> history_slots() const = 0;
   // Forces and torques of the listed contacts added to p.force and p.torque; trial histories
   // written; totals of this rank.
-  virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs, WallPairList& wall_pairs,
-                        double dt, EvaluationTotals& totals) = 0;
+  virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs,
+                        WallPairList& wall_pairs, double dt, EvaluationTotals& totals) = 0;
 };
 std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table);
 

@@ -67,7 +67,8 @@ class HistoryRecords {
     for (std::size_t k = first; k < first + n; ++k, in += record_bytes()) {
       std::memcpy(&a_[k], in, sizeof(std::int64_t));
       std::memcpy(&b_[k], in + sizeof(std::int64_t), sizeof(std::int64_t));
-      if (width_) std::memcpy(&values_[k * width_], in + 2 * sizeof(std::int64_t), width_ * sizeof(double));
+      if (width_)
+        std::memcpy(&values_[k * width_], in + 2 * sizeof(std::int64_t), width_ * sizeof(double));
     }
   }
 

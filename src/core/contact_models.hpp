@@ -25,8 +25,8 @@
 //
 // Each law is written once, generic over the value type T: double (one contact) or Pack (a
 // SIMD pack of contacts, core/simd.hpp), and over the coefficient type C (the law's
-// Coeffs<double>, or Coeffs<Pack> with one material pair per lane). Branches are selects, so both instantiations
-// perform the same IEEE operations and give the same bits.
+// Coeffs<double>, or Coeffs<Pack> with one material pair per lane). Branches are selects, so both
+// instantiations perform the same IEEE operations and give the same bits.
 #pragma once
 
 #include <algorithm>
@@ -84,8 +84,10 @@ template <template <class> class Coeffs, class At>
   Coeffs<Pack> out;
   auto dst = Coeffs<Pack>::tie(out);
   [&]<std::size_t... I>(std::index_sequence<I...>) {
-    ((std::get<I>(dst) = Pack([&](auto l) { return std::get<I>(Coeffs<double>::tie(at(l))); })), ...);
-  }(std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
+    ((std::get<I>(dst) = Pack([&](auto l) { return std::get<I>(Coeffs<double>::tie(at(l))); })),
+     ...);
+  }
+  (std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
   return out;
 }
 // The same coefficients in every lane.
@@ -96,7 +98,8 @@ inline Coeffs<Pack> broadcast_coeffs(const Coeffs<double>& c) {
   const auto src = Coeffs<double>::tie(c);
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     ((std::get<I>(dst) = Pack(std::get<I>(src))), ...);
-  }(std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
+  }
+  (std::make_index_sequence<std::tuple_size_v<decltype(dst)>>{});
   return out;
 }
 
@@ -140,8 +143,8 @@ inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
 
 // Hertz-Mindlin "no-slip" (seed 004, EDEM):
 //   S_n = 2 E* sqrt(R* delta), F_n = 4/3 E* sqrt(R*) delta^1.5 - 2 sqrt(5/6) beta sqrt(S_n m*) v_n,
-//   S_t = 8 G* sqrt(R* delta), F_t = -S_t xi - 2 sqrt(5/6) beta sqrt(S_t m*) v_t, |F_t| <= mu_s F_n,
-//   beta mapped from the restitution asked for the clamped law (materials.hpp).
+//   S_t = 8 G* sqrt(R* delta), F_t = -S_t xi - 2 sqrt(5/6) beta sqrt(S_t m*) v_t, |F_t| <= mu_s
+//   F_n, beta mapped from the restitution asked for the clamped law (materials.hpp).
 // Strain energy (breakage): the Hertz energy 8/15 E* sqrt(R*) delta^2.5.
 struct HertzMindlin {
   static constexpr ContactModelKind kKind = ContactModelKind::kHertzMindlin;
@@ -155,10 +158,13 @@ struct HertzMindlin {
     V damp{};              // -2 sqrt(5/6) beta >= 0
     V tangential_ratio{};  // sqrt(S_t / S_n) = sqrt(4 G* / E*)
     template <class S>
-    static auto tie(S& c) { return std::tie(c.e_star, c.g_star, c.mu_s, c.damp, c.tangential_ratio); }
+    static auto tie(S& c) {
+      return std::tie(c.e_star, c.g_star, c.mu_s, c.damp, c.tangential_ratio);
+    }
   };
   static Coeffs<double> coeffs(const MaterialPair& m) {
-    return {m.e_star, m.g_star, m.mu_s, -2.0 * std::sqrt(5.0 / 6.0) * hertz_beta_for_restitution(m.restitution),
+    return {m.e_star, m.g_star, m.mu_s,
+            -2.0 * std::sqrt(5.0 / 6.0) * hertz_beta_for_restitution(m.restitution),
             std::sqrt(4.0 * m.g_star / m.e_star)};
   }
   template <class T, class C>
@@ -178,16 +184,16 @@ struct HertzMindlin {
     out.strain = out.elastic;
     out.k_rate = 0.5 * k.v_n / k.delta;  // d ln sqrt(delta) / dt, with d(delta)/dt = v_n
     const T s_t = 8.0 * c.g_star * s;
-    tangential_spring(s_t, out.k_rate, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t, dt,
-                      old[0], h[0], out);
+    tangential_spring(s_t, out.k_rate, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t,
+                      dt, old[0], h[0], out);
     return out;
   }
 };
 
 // The thesis's law as written (T9-T23): Hertz stiffness k_n = 4/3 E* sqrt(R* delta) (T11),
 // viscous normal damping c_n = 2 zeta_n sqrt(m* S_n) (T22), pure Coulomb sliding
-// F_s = mu_s F_n sign(v_t) (T13) plus tangential damping c_t = 4 zeta_t sqrt(m* 2 G* sqrt(R* delta))
-// (T23), torques with the arm R* (T15). Normal force clamped at zero like the others. No
+// F_s = mu_s F_n sign(v_t) (T13) plus tangential damping c_t = 4 zeta_t sqrt(m* 2 G* sqrt(R*
+// delta)) (T23), torques with the arm R* (T15). Normal force clamped at zero like the others. No
 // history. Strain energy (breakage): k_n delta^2 / 2 (T35).
 struct ThesisModel {
   static constexpr ContactModelKind kKind = ContactModelKind::kThesis;
@@ -199,12 +205,17 @@ struct ThesisModel {
   struct Coeffs {
     V e_star{}, g_star{}, mu_s{}, zeta_n{}, zeta_t{};
     template <class S>
-    static auto tie(S& c) { return std::tie(c.e_star, c.g_star, c.mu_s, c.zeta_n, c.zeta_t); }
+    static auto tie(S& c) {
+      return std::tie(c.e_star, c.g_star, c.mu_s, c.zeta_n, c.zeta_t);
+    }
   };
-  static Coeffs<double> coeffs(const MaterialPair& m) { return {m.e_star, m.g_star, m.mu_s, m.zeta_n, m.zeta_t}; }
+  static Coeffs<double> coeffs(const MaterialPair& m) {
+    return {m.e_star, m.g_star, m.mu_s, m.zeta_n, m.zeta_t};
+  }
   template <class T, class C>
   [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                          const History<T>&, History<T>&, double dt) {
+                                                          const History<T>&, History<T>&,
+                                                          double dt) {
     ContactForceT<T> out;
     const T s = vsqrt(k.r_eff * k.delta);
     const T s_n = 2.0 * c.e_star * s;
@@ -240,14 +251,16 @@ struct LinearModel {
     V kn_const{}, kn_per_radius{};  // k_n = kn_const + kn_per_radius R*
     V gamma{};                      // damping ratio
     template <class S>
-    static auto tie(S& c) { return std::tie(c.mu_s, c.kn_const, c.kn_per_radius, c.gamma); }
+    static auto tie(S& c) {
+      return std::tie(c.mu_s, c.kn_const, c.kn_per_radius, c.gamma);
+    }
   };
   static Coeffs<double> coeffs(const MaterialPair& m) {
     // k_n: the mean of the materials' `normal_stiffness` when both give one; otherwise the Hertz
     // secant stiffness at an overlap of 1 % of R*, 4/3 E* sqrt(R* 0.01 R*).
     const bool given = m.a.normal_stiffness > 0.0 && m.b.normal_stiffness > 0.0;
-    return {m.mu_s, given ? m.mean(&MaterialSpec::normal_stiffness) : 0.0, given ? 0.0 : 4.0 / 3.0 * m.e_star * 0.1,
-            linear_gamma_for_restitution(m.restitution)};
+    return {m.mu_s, given ? m.mean(&MaterialSpec::normal_stiffness) : 0.0,
+            given ? 0.0 : 4.0 / 3.0 * m.e_star * 0.1, linear_gamma_for_restitution(m.restitution)};
   }
   template <class T, class C>
   [[gnu::always_inline]] static ContactForceT<T> evaluate(const C& c, const KinematicsT<T>& k,
@@ -283,13 +296,15 @@ struct RollingNone {
   template <class V>
   struct Coeffs {
     template <class S>
-    static auto tie(S&) { return std::tie(); }
+    static auto tie(S&) {
+      return std::tie();
+    }
   };
   static Coeffs<double> coeffs(const MaterialPair&, double) { return {}; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C&, const KinematicsT<T>&,
-                                                           const ContactForceT<T>&, const History<T>&,
-                                                           History<T>&, double) {
+                                                           const ContactForceT<T>&,
+                                                           const History<T>&, History<T>&, double) {
     return {};
   }
 };
@@ -306,13 +321,16 @@ struct RollingConstant {
   struct Coeffs {
     V mu_r{};
     template <class S>
-    static auto tie(S& c) { return std::tie(c.mu_r); }
+    static auto tie(S& c) {
+      return std::tie(c.mu_r);
+    }
   };
   static Coeffs<double> coeffs(const MaterialPair& m, double) { return {m.mu_r}; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                           const ContactForceT<T>& cf, const History<T>&,
-                                                           History<T>&, double dt) {
+                                                           const ContactForceT<T>& cf,
+                                                           const History<T>&, History<T>&,
+                                                           double dt) {
     const T m = -c.mu_r * cf.f_n * k.r_eff * vsign(k.omega_rel);
     return {m, -m * k.omega_rel * dt, T(0.0)};
   }
@@ -329,7 +347,8 @@ struct RollingEpsd {
   static constexpr RollingModelKind kKind = RollingModelKind::kEpsd;
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = true;
-  static constexpr std::array<HistorySlot, 1> kHistory{{{"m_roll", "N m", "rolling spring torque"}}};
+  static constexpr std::array<HistorySlot, 1> kHistory{
+      {{"m_roll", "N m", "rolling spring torque"}}};
   template <class T>
   using History = HistoryArray<T, kHistory.size()>;
   template <class V>
@@ -337,13 +356,18 @@ struct RollingEpsd {
     V mu_r{};
     V eta{};  // rolling dashpot damping ratio eta_r
     template <class S>
-    static auto tie(S& c) { return std::tie(c.mu_r, c.eta); }
+    static auto tie(S& c) {
+      return std::tie(c.mu_r, c.eta);
+    }
   };
-  static Coeffs<double> coeffs(const MaterialPair& m, double rolling_damping) { return {m.mu_r, rolling_damping}; }
+  static Coeffs<double> coeffs(const MaterialPair& m, double rolling_damping) {
+    return {m.mu_r, rolling_damping};
+  }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
-                                                           const ContactForceT<T>& cf, const History<T>& old,
-                                                           History<T>& h, double dt) {
+                                                           const ContactForceT<T>& cf,
+                                                           const History<T>& old, History<T>& h,
+                                                           double dt) {
     const T k_r = 2.25 * cf.k_n * c.mu_r * c.mu_r * k.r_eff * k.r_eff;
     const auto active = k_r > 0.0;  // mu_r = 0: no rolling spring at all
     const T m_max = c.mu_r * k.r_eff * cf.f_n;
@@ -355,21 +379,22 @@ struct RollingEpsd {
     // Full mobilisation: plastic rolling at the cap, no dashpot.
     const auto full = vabs(m_k) >= m_max;
     const T m_full = vcopysign(m_max, m_k);
-    const T diss_full =
-        -m_full * k.omega_rel * dt - half_compliance * (m_full * m_full - stored_old) + stiffness_change;
+    const T diss_full = -m_full * k.omega_rel * dt -
+                        half_compliance * (m_full * m_full - stored_old) + stiffness_change;
     // Elastic: spring plus dashpot, the sum capped too.
     const T c_r = c.eta * 2.0 * vsqrt(k.i_eff * k_r);
     const T m = m_k - c_r * k.omega_rel;
     const auto over = vabs(m) > m_max;
     const T m_capped = vcopysign(m_max, m);
-    const T diss_over =
-        -m_capped * k.omega_rel * dt - half_compliance * (m_k * m_k - stored_old) + stiffness_change;
+    const T diss_over = -m_capped * k.omega_rel * dt - half_compliance * (m_k * m_k - stored_old) +
+                        stiffness_change;
     const T diss_free = c_r * k.omega_rel * k.omega_rel * dt + stiffness_change;
     const T spring = select(full, m_full, m_k);
     h[0] = select(active, spring, T(0.0));
     RollingTorqueT<T> out;
     out.torque = select(active, select(full, m_full, select(over, m_capped, m)), T(0.0));
-    out.dissipated = select(active, select(full, diss_full, select(over, diss_over, diss_free)), T(0.0));
+    out.dissipated =
+        select(active, select(full, diss_full, select(over, diss_over, diss_free)), T(0.0));
     out.elastic = select(active, half_compliance * spring * spring, T(0.0));
     return out;
   }
@@ -389,7 +414,8 @@ struct TrackNone {
   template <class T>
   using History = HistoryArray<T, 0>;
   template <class T>
-  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>&, const History<T>&, History<T>&) {}
+  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>&, const History<T>&,
+                                              History<T>&) {}
 };
 
 // The largest strain energy of the contact so far (the breakage test reads it at the peak or
@@ -400,7 +426,8 @@ struct TrackPeakEnergy {
   template <class T>
   using History = HistoryArray<T, kHistory.size()>;
   template <class T>
-  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>& cf, const History<T>& old, History<T>& h) {
+  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>& cf, const History<T>& old,
+                                              History<T>& h) {
     h[0] = vmax(old[0], cf.strain);
   }
 };
@@ -452,11 +479,14 @@ struct ContactModel {
   [[gnu::always_inline]] static Coeffs<Pack> gather(const Coeffs<double>* table, Index index) {
     using LawC = typename Law::template Coeffs<double>;
     using RollC = typename Rolling::template Coeffs<double>;
-    return {gather_coeffs<Law::template Coeffs>([&](auto l) -> const LawC& { return table[index(l)].law; }),
-            gather_coeffs<Rolling::template Coeffs>([&](auto l) -> const RollC& { return table[index(l)].rolling; })};
+    return {gather_coeffs<Law::template Coeffs>(
+                [&](auto l) -> const LawC& { return table[index(l)].law; }),
+            gather_coeffs<Rolling::template Coeffs>(
+                [&](auto l) -> const RollC& { return table[index(l)].rolling; })};
   }
   static Coeffs<Pack> broadcast(const Coeffs<double>& c) {
-    return {broadcast_coeffs<Law::template Coeffs>(c.law), broadcast_coeffs<Rolling::template Coeffs>(c.rolling)};
+    return {broadcast_coeffs<Law::template Coeffs>(c.law),
+            broadcast_coeffs<Rolling::template Coeffs>(c.rolling)};
   }
 
   // One contact (or one per lane): the law, then the rolling model on the law's normal force,
@@ -467,7 +497,8 @@ struct ContactModel {
                                                              double dt) {
     ContactResponseT<T> out;
     out.law = Law::evaluate(c.law, kin, old.law, h.law, dt);
-    if constexpr (Rolling::kActive) out.rolling = Rolling::evaluate(c.rolling, kin, out.law, old.rolling, h.rolling, dt);
+    if constexpr (Rolling::kActive)
+      out.rolling = Rolling::evaluate(c.rolling, kin, out.law, old.rolling, h.rolling, dt);
     Tracker::evaluate(out.law, old.tracker, h.tracker);
     return out;
   }

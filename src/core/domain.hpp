@@ -66,7 +66,8 @@ class Domain {
   // so the result is the same on every rank), and each ghost's `recv_fields` receive its
   // owner's `send_fields` (same types, in the same order; only halo_sources() are read).
   virtual void exchange_step(ParticleStore& /*p*/, std::span<FieldBase* const> /*send_fields*/,
-                             std::span<FieldBase* const> /*recv_fields*/, std::span<double> /*values*/) {}
+                             std::span<FieldBase* const> /*recv_fields*/,
+                             std::span<double> /*values*/) {}
   // Called after each neighbour rebuild with the work of each owned particle (1 + its share
   // of the listed pairs: half of a pair between two owned particles, all of a pair with a
   // ghost, which both ranks compute), in store order; the rank's work is their sum. A parallel

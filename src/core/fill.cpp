@@ -53,7 +53,9 @@ class PlacedGrid {
   std::pair<long, long> index(Vec2 x) const {
     return {static_cast<long>(std::floor(x.x / h_)), static_cast<long>(std::floor(x.y / h_))};
   }
-  static long long pack(long x, long y) { return (static_cast<long long>(x) << 32) ^ (y & 0xffffffffLL); }
+  static long long pack(long x, long y) {
+    return (static_cast<long long>(x) << 32) ^ (y & 0xffffffffLL);
+  }
   long long key(Vec2 x) const {
     const auto [a, b] = index(x);
     return pack(a, b);
@@ -84,7 +86,8 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   std::int64_t next_id = static_cast<std::int64_t>(store.size());
   for (const ParticleSpec& s : scene.particles) {
     const int mat = find_material(scene, s.material);
-    store.add(next_id++, mat, s.radius, scene.materials[mat].density, s.position, s.velocity, s.spin);
+    store.add(next_id++, mat, s.radius, scene.materials[mat].density, s.position, s.velocity,
+              s.spin);
   }
   double r_all_max = 0.0;
   for (std::size_t k = 0; k < store.size(); ++k) r_all_max = std::max(r_all_max, store.radius[k]);
@@ -95,7 +98,8 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
     const FillSpec& s = scene.fills[f];
     const bool needs_drum = s.region != FillRegion::kBox;
     if (needs_drum && !scene.drum.present) {
-      errors.push_back(where(scene, s) + "region needs a [drum]; use region = \"box\" with box_min and box_max");
+      errors.push_back(where(scene, s) +
+                       "region needs a [drum]; use region = \"box\" with box_min and box_max");
       continue;
     }
     const std::int64_t n = fill_count(scene, f);
@@ -105,8 +109,9 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
     const Vec2 c = scene.drum.center;
     double r_in = 0.0;
     if (needs_drum) {
-      r_in = scene.drum.sides == 0 ? scene.drum.radius
-                                   : scene.drum.radius * std::cos(std::numbers::pi / scene.drum.sides);
+      r_in = scene.drum.sides == 0
+                 ? scene.drum.radius
+                 : scene.drum.radius * std::cos(std::numbers::pi / scene.drum.sides);
       lo = c - Vec2{r_in, r_in};
       hi = c + Vec2{r_in, r_in};
     }
@@ -136,19 +141,22 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
       }
     }
     if (static_cast<std::int64_t>(sites.size()) < n) {
-      errors.push_back(where(scene, s) + std::to_string(n) + " particles do not fit: the region holds " +
-                       std::to_string(sites.size()) + " at radius_max " + std::to_string(s.radius_max) +
+      errors.push_back(where(scene, s) + std::to_string(n) +
+                       " particles do not fit: the region holds " + std::to_string(sites.size()) +
+                       " at radius_max " + std::to_string(s.radius_max) +
                        " m; lower count or fill_fraction, or enlarge the region");
       continue;
     }
-    std::stable_sort(sites.begin(), sites.end(), [](const Site& a, const Site& b) { return a.key < b.key; });
+    std::stable_sort(sites.begin(), sites.end(),
+                     [](const Site& a, const Site& b) { return a.key < b.key; });
     const int mat = find_material(scene, s.material);
     for (std::int64_t k = 0; k < n; ++k) {
       const double r = fill_radius(scene, f, k);
       // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
       const double slack = half - r;
       const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
-      const double jy = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
+      const double jy =
+          random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
       const Vec2 x = sites[k].x + (slack * 0.7071) * Vec2{jx, jy};
       store.add(next_id++, mat, r, scene.materials[mat].density, x, s.velocity, 0.0);
     }

@@ -15,9 +15,10 @@ void RebuildMonitor::record(const ParticleStore& p, const Walls& walls, double t
 }
 
 bool RebuildMonitor::due(double displacement, const Walls& walls, double time, double ahead) const {
-  const double wall_move = walls.rotating_reach() * (std::abs(walls.drum_angle() - drum_angle_at_build_) +
-                                                     std::abs(walls.drum_speed()) * ahead) +
-                           walls.max_translation_speed() * (time + ahead - time_at_build_);
+  const double wall_move =
+      walls.rotating_reach() * (std::abs(walls.drum_angle() - drum_angle_at_build_) +
+                                std::abs(walls.drum_speed()) * ahead) +
+      walls.max_translation_speed() * (time + ahead - time_at_build_);
   return 2.0 * displacement + wall_move >= skin_;
 }
 
@@ -26,7 +27,8 @@ bool RebuildMonitor::due(double displacement, const Walls& walls, double time, d
 
 std::unique_ptr<Integrator> make_integrator(const RunSpec& run, double dt, Vec2 gravity) {
   if (run.integrator == IntegratorKind::kIterative)
-    return std::make_unique<IterativeIntegrator>(dt, gravity, run.tolerance, std::max(1, run.max_passes));
+    return std::make_unique<IterativeIntegrator>(dt, gravity, run.tolerance,
+                                                 std::max(1, run.max_passes));
   return std::make_unique<VelocityVerlet>(dt, gravity);
 }
 
@@ -141,7 +143,8 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
   return {reduce[0] != 0.0, c.checksum};
 }
 
-void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources) {
+void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p,
+                                          std::span<const std::int32_t> sources) {
   const double h = 0.5 * dt_;
   for (const std::int32_t k : sources) {
     const Drifted d = kick_drift(p.pos[k], p.vel[k], p.acc[k], p.omega[k], p.alpha[k], h, dt_);
@@ -194,7 +197,8 @@ bool IterativeIntegrator::rebuild_due(StepStages& s) const {
   const Vec2* x_build = s.rebuilds().positions_at_build();
   double reach = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k)
-    reach = std::max(reach, norm(p.pos[k] - x_build[k]) + norm(p.vel[k]) * dt_ + norm(p.acc[k]) * dt_ * dt_);
+    reach = std::max(
+        reach, norm(p.pos[k] - x_build[k]) + norm(p.vel[k]) * dt_ + norm(p.acc[k]) * dt_ * dt_);
   return s.domain().any(s.rebuilds().due(reach, s.walls(), s.time(), 0.0));
 }
 

@@ -94,8 +94,9 @@ struct PassCounter {
     steps_since_row += 1;
   }
   double mean_since_row() const {
-    return steps_since_row > 0 ? static_cast<double>(since_row) / static_cast<double>(steps_since_row)
-                               : static_cast<double>(last);
+    return steps_since_row > 0
+               ? static_cast<double>(since_row) / static_cast<double>(steps_since_row)
+               : static_cast<double>(last);
   }
 };
 
@@ -125,8 +126,8 @@ struct Drifted {
   Vec2 x, v;
   double w;
 };
-[[gnu::always_inline]] inline Drifted kick_drift(Vec2 x, Vec2 v, Vec2 a, double w, double alpha, double h,
-                                                 double dt) {
+[[gnu::always_inline]] inline Drifted kick_drift(Vec2 x, Vec2 v, Vec2 a, double w, double alpha,
+                                                 double h, double dt) {
   const Vec2 v_half = v + h * a;
   return {x + dt * v_half, v_half, w + h * alpha};
 }

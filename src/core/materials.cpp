@@ -74,24 +74,20 @@ double hertz_beta_for_restitution(double e) {
   static std::map<double, double> cache;
   std::lock_guard<std::mutex> lock(mutex);
   if (auto it = cache.find(e); it != cache.end()) return it->second;
-  const double eta = invert_restitution(
-      e, hertz_clamped, 4.0);
+  const double eta = invert_restitution(e, hertz_clamped, 4.0);
   const double beta = -eta / std::sqrt(5.0);
   cache[e] = beta;
   return beta;
 }
 
-double restitution_linear_clamped(double gamma) {
-  return linear_clamped(2.0 * gamma);
-}
+double restitution_linear_clamped(double gamma) { return linear_clamped(2.0 * gamma); }
 
 double linear_gamma_for_restitution(double e) {
   static std::mutex mutex;
   static std::map<double, double> cache;
   std::lock_guard<std::mutex> lock(mutex);
   if (auto it = cache.find(e); it != cache.end()) return it->second;
-  const double eta = invert_restitution(
-      e, linear_clamped, 4.0);
+  const double eta = invert_restitution(e, linear_clamped, 4.0);
   cache[e] = 0.5 * eta;
   return 0.5 * eta;
 }
@@ -114,7 +110,8 @@ PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.s
       c.a = ma;
       c.b = mb;
       const double nu_a = ma.poisson_ratio, nu_b = mb.poisson_ratio;
-      c.e_star = 1.0 / ((1 - nu_a * nu_a) / ma.youngs_modulus + (1 - nu_b * nu_b) / mb.youngs_modulus);
+      c.e_star =
+          1.0 / ((1 - nu_a * nu_a) / ma.youngs_modulus + (1 - nu_b * nu_b) / mb.youngs_modulus);
       c.g_star = 1.0 / (2 * (2 - nu_a) * (1 + nu_a) / ma.youngs_modulus +
                         2 * (2 - nu_b) * (1 + nu_b) / mb.youngs_modulus);
       c.restitution = mean_or(in.restitution, ma.restitution, mb.restitution);

@@ -20,12 +20,12 @@ namespace dem2d {
 struct MaterialPair {
   MaterialSpec a, b;
   double mean(double MaterialSpec::*property) const { return 0.5 * (a.*property + b.*property); }
-  double e_star = 0.0;            // Pa
-  double g_star = 0.0;            // Pa
-  double restitution = 1.0;       // asked (hertz-mindlin, linear)
-  double mu_s = 0.0;              // sliding friction
-  double mu_r = 0.0;              // rolling friction
-  double zeta_n = 0.0;            // thesis: damping ratios (T22, T23)
+  double e_star = 0.0;       // Pa
+  double g_star = 0.0;       // Pa
+  double restitution = 1.0;  // asked (hertz-mindlin, linear)
+  double mu_s = 0.0;         // sliding friction
+  double mu_r = 0.0;         // rolling friction
+  double zeta_n = 0.0;       // thesis: damping ratios (T22, T23)
   double zeta_t = 0.0;
 };
 

@@ -12,22 +12,24 @@ namespace {
 // Carry histories (`width` values per contact) from `old` (sorted keys) to `fresh` (sorted
 // keys) by key equality; new contacts start at zero.
 template <class KeyOld, class KeyNew>
-void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old, const Array<double>& hist_old,
-                   std::size_t n_new, KeyNew key_new, Array<double>& hist_new) {
+void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old,
+                   const Array<double>& hist_old, std::size_t n_new, KeyNew key_new,
+                   Array<double>& hist_new) {
   hist_new.assign(n_new * width, 0.0);
   if (width == 0) return;
   std::size_t a = 0;
   for (std::size_t b = 0; b < n_new && a < n_old; ++b) {
     const auto kb = key_new(b);
     while (a < n_old && key_old(a) < kb) ++a;
-    if (a < n_old && key_old(a) == kb) std::copy_n(&hist_old[a * width], width, &hist_new[b * width]);
+    if (a < n_old && key_old(a) == kb)
+      std::copy_n(&hist_old[a * width], width, &hist_new[b * width]);
   }
 }
 
 }  // namespace
 
-void NeighborSearch::build(const ParticleStore& p, const Walls& walls, double skin,
-                           PairList& pairs, WallPairList& wall_pairs) {
+void NeighborSearch::build(const ParticleStore& p, const Walls& walls, double skin, PairList& pairs,
+                           WallPairList& wall_pairs) {
   ++builds_;
   // Indices in id order (the identity when the store is kept sorted by id).
   const std::size_t n = p.size();
@@ -118,8 +120,14 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
     }
   }
   merge_history(
-      out.width, out.size(), [&](std::size_t k) { return std::pair{out.id_i[k], out.id_j[k]}; }, out.history,
-      fresh.size(), [&](std::size_t k) { return std::pair{fresh.id_i[k], fresh.id_j[k]}; },
+      out.width, out.size(),
+      [&](std::size_t k) {
+        return std::pair{out.id_i[k], out.id_j[k]};
+      },
+      out.history, fresh.size(),
+      [&](std::size_t k) {
+        return std::pair{fresh.id_i[k], fresh.id_j[k]};
+      },
       fresh.history);
   fresh.trial = fresh.history;
   out = std::move(fresh);
@@ -161,8 +169,14 @@ void NeighborSearch::build_wall_pairs(const ParticleStore& p, const Walls& walls
     }
   }
   merge_history(
-      out.width, out.size(), [&](std::size_t k) { return std::pair{out.id[k], out.element[k]}; }, out.history,
-      fresh.size(), [&](std::size_t k) { return std::pair{fresh.id[k], fresh.element[k]}; },
+      out.width, out.size(),
+      [&](std::size_t k) {
+        return std::pair{out.id[k], out.element[k]};
+      },
+      out.history, fresh.size(),
+      [&](std::size_t k) {
+        return std::pair{fresh.id[k], fresh.element[k]};
+      },
       fresh.history);
   fresh.trial = fresh.history;
   out = std::move(fresh);

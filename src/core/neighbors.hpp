@@ -22,15 +22,15 @@ struct PairList {
   Array<std::int32_t> i, j;        // local indices
   Array<std::int64_t> id_i, id_j;  // keys, id_i < id_j
   std::size_t width = 0;           // history values per contact
-  Array<double> history;           // committed at the end of each step: [k * width, (k + 1) * width)
-  Array<double> trial;             // written by each force evaluation
+  Array<double> history;  // committed at the end of each step: [k * width, (k + 1) * width)
+  Array<double> trial;    // written by each force evaluation
   std::size_t size() const { return i.size(); }
   const double* history_of(std::size_t k) const { return history.data() + k * width; }
 };
 
 struct WallPairList {
   Array<std::int32_t> particle, element;
-  Array<std::int64_t> id;          // particle id (key with element)
+  Array<std::int64_t> id;  // particle id (key with element)
   std::size_t width = 0;
   Array<double> history;
   Array<double> trial;

@@ -19,8 +19,8 @@ void ParticleStore::resize_all(std::size_t n) {
   for (FieldBase* f : registry_) f->resize(n);
 }
 
-std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, double density,
-                               Vec2 x, Vec2 v, double spin) {
+std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, double density, Vec2 x,
+                               Vec2 v, double spin) {
   if (n_ghost() != 0) throw std::logic_error("ParticleStore::add with ghosts present");
   const std::size_t i = size();
   resize_all(i + 1);

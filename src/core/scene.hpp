@@ -21,12 +21,12 @@ enum class IntegratorKind { kVerlet, kIterative };
 
 struct MaterialSpec {
   std::string name;
-  double density = 0.0;          // kg/m^3
-  double youngs_modulus = 0.0;   // Pa
-  double poisson_ratio = 0.25;   // resolved: the parser derives it from shear_modulus if given
-  double shear_modulus = 0.0;    // Pa, resolved: G = E / (2 (1 + nu)) when not given
-  double restitution = 0.5;      // hertz-mindlin and linear: coefficient of restitution asked
-  double damping_normal = 0.1;   // thesis model: zeta_n (T22)
+  double density = 0.0;             // kg/m^3
+  double youngs_modulus = 0.0;      // Pa
+  double poisson_ratio = 0.25;      // resolved: the parser derives it from shear_modulus if given
+  double shear_modulus = 0.0;       // Pa, resolved: G = E / (2 (1 + nu)) when not given
+  double restitution = 0.5;         // hertz-mindlin and linear: coefficient of restitution asked
+  double damping_normal = 0.1;      // thesis model: zeta_n (T22)
   double damping_tangential = 0.1;  // thesis model: zeta_t (T23)
   double sliding_friction = 0.5;    // mu_s
   double rolling_friction = 0.0;    // mu_r (dimensionless, times R*)
@@ -45,25 +45,25 @@ struct InteractionSpec {
 };
 
 struct RunSpec {
-  double duration = 1.0;           // s of simulated time
-  double dt = 0.0;                 // s; 0 means "auto"
+  double duration = 1.0;  // s of simulated time
+  double dt = 0.0;        // s; 0 means "auto"
   bool dt_auto = true;
   IntegratorKind integrator = IntegratorKind::kVerlet;
-  double tolerance = 1.0e-6;       // iterative: relative acceleration change (thesis T31)
-  int max_passes = 20;             // iterative
+  double tolerance = 1.0e-6;  // iterative: relative acceleration change (thesis T31)
+  int max_passes = 20;        // iterative
   std::uint64_t seed = 1;
   Vec2 gravity{0.0, -9.81};
-  double skin = -1.0;              // m, Verlet skin; < 0: 0.4 of the smallest radius (core)
-  double dt_safety = 0.2;          // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
-  bool allow_unsafe_dt = false;    // run anyway (with a warning) when dt exceeds the safe bound
-  int sectors_per_rank = 32;       // parallel runs: angular sectors per rank (METIS groups them)
+  double skin = -1.0;            // m, Verlet skin; < 0: 0.4 of the smallest radius (core)
+  double dt_safety = 0.2;        // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
+  bool allow_unsafe_dt = false;  // run anyway (with a warning) when dt exceeds the safe bound
+  int sectors_per_rank = 32;     // parallel runs: angular sectors per rank (METIS groups them)
   double repartition_threshold = 1.05;  // parallel runs: max/mean work that triggers a repartition
 };
 
 struct ContactSpec {
   ContactModelKind model = ContactModelKind::kHertzMindlin;
   RollingModelKind rolling = RollingModelKind::kEpsd;
-  double rolling_damping = 0.3;    // epsd: eta_r, the rolling dashpot's damping ratio
+  double rolling_damping = 0.3;  // epsd: eta_r, the rolling dashpot's damping ratio
   // Tracker slot: every contact records its peak strain energy (a history slot). Not a deck
   // key: set by the models that read it (breakage, not yet built) and by tests.
   bool track_peak_energy = false;
@@ -81,10 +81,10 @@ struct DrumSpec {
   bool present = false;
   double radius = 0.0;
   Vec2 center{0.0, 0.0};
-  double speed = 0.0;        // rad/s, counter-clockwise positive (resolved from rpm / critical_fraction)
-  double ramp_time = 0.0;    // s to reach the speed (linear ramp from 0)
-  int sides = 0;             // 0: exact circle; N >= 3: regular N-gon with vertices on the circle
-  double angle = 0.0;        // rad, initial drum angle
+  double speed = 0.0;  // rad/s, counter-clockwise positive (resolved from rpm / critical_fraction)
+  double ramp_time = 0.0;  // s to reach the speed (linear ramp from 0)
+  int sides = 0;           // 0: exact circle; N >= 3: regular N-gon with vertices on the circle
+  double angle = 0.0;      // rad, initial drum angle
   std::string material;
   std::vector<LifterSpec> lifters;
 };
@@ -100,10 +100,10 @@ struct FillSpec {
   double radius_min = 0.0;     // mono-disperse: radius_min == radius_max
   double radius_max = 0.0;
   FillRegion region = FillRegion::kBottom;
-  Vec2 box_min{0.0, 0.0};      // region = "box"
+  Vec2 box_min{0.0, 0.0};  // region = "box"
   Vec2 box_max{0.0, 0.0};
-  Vec2 velocity{0.0, 0.0};     // initial velocity of every filled particle
-  int source_line = 0;         // deck line, for error messages
+  Vec2 velocity{0.0, 0.0};  // initial velocity of every filled particle
+  int source_line = 0;      // deck line, for error messages
 };
 
 struct ParticleSpec {
@@ -138,7 +138,7 @@ struct Scene {
   std::vector<MaterialSpec> materials;
   std::vector<InteractionSpec> interactions;
   DrumSpec drum;
-  std::vector<FillSpec> fills;       // count / fill_fraction fills: the core places them
+  std::vector<FillSpec> fills;  // count / fill_fraction fills: the core places them
   // [[fill]] tables with a `file`, as a record (run.json, the resolved deck): the parser has
   // already read each CSV into `particles`, after the [[particle]] tables, in this order; here
   // `count` is the number of rows read and `material` / `velocity` are the defaults for rows

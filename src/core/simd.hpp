@@ -14,6 +14,7 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <immintrin.h>
+
 #include <experimental/simd>
 #pragma GCC diagnostic pop
 
@@ -40,9 +41,13 @@ inline constexpr int kPackSize = static_cast<int>(Pack::size());
 [[gnu::always_inline]] inline double vmin(double a, double b) { return std::min(a, b); }
 [[gnu::always_inline]] inline Pack vmin(const Pack& a, const Pack& b) { return stdx::min(a, b); }
 [[gnu::always_inline]] inline double vcopysign(double m, double s) { return std::copysign(m, s); }
-[[gnu::always_inline]] inline Pack vcopysign(const Pack& m, const Pack& s) { return stdx::copysign(m, s); }
+[[gnu::always_inline]] inline Pack vcopysign(const Pack& m, const Pack& s) {
+  return stdx::copysign(m, s);
+}
 // sign(x): -1, 0 or +1.
-[[gnu::always_inline]] inline double vsign(double x) { return select(x > 0.0, 1.0, select(x < 0.0, -1.0, 0.0)); }
+[[gnu::always_inline]] inline double vsign(double x) {
+  return select(x > 0.0, 1.0, select(x < 0.0, -1.0, 0.0));
+}
 [[gnu::always_inline]] inline Pack vsign(const Pack& x) {
   return select(x > 0.0, Pack(1.0), select(x < 0.0, Pack(-1.0), Pack(0.0)));
 }

@@ -32,7 +32,8 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
     r_min = std::min(r_min, particles_.radius[k]);
     r_max = std::max(r_max, particles_.radius[k]);
   }
-  rebuilds_ = RebuildMonitor(scene_.run.skin >= 0.0 ? scene_.run.skin : (particles_.size() ? 0.4 * r_min : 0.0));
+  rebuilds_ = RebuildMonitor(scene_.run.skin >= 0.0 ? scene_.run.skin
+                                                    : (particles_.size() ? 0.4 * r_min : 0.0));
   // Every rank placed the same particles; from here on each keeps its own (parallel runs).
   // A pair interacts within r_i + r_j + skin, so a rank needs the particles within
   // 2 r_max + skin of its region.
@@ -54,9 +55,10 @@ void Simulation::choose_dt() {
   if (dt_ > scales_.limit_dt && !scene_.run.allow_unsafe_dt) {
     std::ostringstream o;
     o << scene_.deck_path << ": error: run.dt = " << dt_ << " s is unsafe: it exceeds half of "
-      << "the smallest Rayleigh time (" << format_seconds(scales_.rayleigh) << ") or Hertz contact time ("
-      << format_seconds(scales_.hertz) << " at " << scales_.impact_speed << " m/s); the safe dt is "
-      << scales_.safe_dt << " s (dt = \"auto\"); set run.allow_unsafe_dt = true to run anyway";
+      << "the smallest Rayleigh time (" << format_seconds(scales_.rayleigh)
+      << ") or Hertz contact time (" << format_seconds(scales_.hertz) << " at "
+      << scales_.impact_speed << " m/s); the safe dt is " << scales_.safe_dt
+      << " s (dt = \"auto\"); set run.allow_unsafe_dt = true to run anyway";
     throw InputError(o.str());
   }
 }
@@ -144,16 +146,18 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
     const ParticleStore& p = particles_;
     for (std::size_t k = 0; k < p.n_owned() && named < 5; ++k) {
       const Vec2 a = p.acc[k];
-      if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(p.alpha[k]) && std::isfinite(p.pos[k].x) &&
-          std::isfinite(p.pos[k].y))
+      if (std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(p.alpha[k]) &&
+          std::isfinite(p.pos[k].x) && std::isfinite(p.pos[k].y))
         continue;
       o << (named++ ? ", particle " : " of particle ") << p.id[k];
     }
   } else {
     // The pair at the largest overlap, named alike on every rank (ids are below 2^53).
     const bool mine = totals.max_overlap == max_overlap;
-    const auto worst_a = static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_a) : -2.0));
-    const auto worst_b = static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_b) : -2.0));
+    const auto worst_a =
+        static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_a) : -2.0));
+    const auto worst_b =
+        static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_b) : -2.0));
     o << "overlap " << max_overlap << " of a radius between particle " << worst_a;
     if (worst_b >= 0)
       o << " and particle " << worst_b;

@@ -51,14 +51,16 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   for (std::size_t a = 0; a < nm; ++a) {
     if (r_min[a] == std::numeric_limits<double>::max()) continue;
     const MaterialSpec& m = scene.materials[a];
-    ts.rayleigh = std::min(ts.rayleigh, std::numbers::pi * r_min[a] * std::sqrt(m.density / m.shear_modulus) /
-                                             (0.1631 * m.poisson_ratio + 0.8766));
+    ts.rayleigh =
+        std::min(ts.rayleigh, std::numbers::pi * r_min[a] * std::sqrt(m.density / m.shear_modulus) /
+                                  (0.1631 * m.poisson_ratio + 0.8766));
     // Hertz contact time of the smallest sphere against a wall of the stiffest material
     // (m* = m, R* = r): t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5).
     for (std::size_t b = 0; b < nm; ++b) {
       const double mass = ParticleStore::sphere_mass(r_min[a], m.density);
       const double e_star = table(static_cast<int>(a), static_cast<int>(b)).e_star;
-      const double tc = 2.868 * std::pow(mass * mass / (r_min[a] * e_star * e_star * ts.impact_speed), 0.2);
+      const double tc =
+          2.868 * std::pow(mass * mass / (r_min[a] * e_star * e_star * ts.impact_speed), 0.2);
       ts.hertz = std::min(ts.hertz, tc);
     }
   }

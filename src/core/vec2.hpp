@@ -11,9 +11,21 @@ struct Vec2 {
   double x = 0.0;
   double y = 0.0;
 
-  constexpr Vec2& operator+=(Vec2 b) { x += b.x; y += b.y; return *this; }
-  constexpr Vec2& operator-=(Vec2 b) { x -= b.x; y -= b.y; return *this; }
-  constexpr Vec2& operator*=(double s) { x *= s; y *= s; return *this; }
+  constexpr Vec2& operator+=(Vec2 b) {
+    x += b.x;
+    y += b.y;
+    return *this;
+  }
+  constexpr Vec2& operator-=(Vec2 b) {
+    x -= b.x;
+    y -= b.y;
+    return *this;
+  }
+  constexpr Vec2& operator*=(double s) {
+    x *= s;
+    y *= s;
+    return *this;
+  }
 };
 
 constexpr Vec2 operator+(Vec2 a, Vec2 b) { return {a.x + b.x, a.y + b.y}; }

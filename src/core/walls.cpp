@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <numbers>
+#include <utility>
 
 namespace dem2d {
 
@@ -53,7 +53,8 @@ Walls::Walls(const Scene& scene) {
       const int lmat = l.material.empty() ? mat : find_material(scene, l.material);
       // A bar of width w standing on the shell, height h measured radially from the shell's
       // inner surface (the circle, or the polygon's inscribed circle at the bar's foot).
-      const double inner = d.sides == 0 ? d.radius : d.radius * std::cos(std::numbers::pi / d.sides);
+      const double inner =
+          d.sides == 0 ? d.radius : d.radius * std::cos(std::numbers::pi / d.sides);
       for (int k = 0; k < l.count; ++k) {
         const double phi = l.angle + 2.0 * std::numbers::pi * k / l.count;
         const Vec2 radial{std::cos(phi), std::sin(phi)};

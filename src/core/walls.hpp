@@ -19,15 +19,15 @@
 namespace dem2d {
 
 struct WallBody {
-  Vec2 center{};         // rotation centre (drum) or reference point (translating wall)
-  double speed = 0.0;    // rad/s at full speed (drum)
+  Vec2 center{};       // rotation centre (drum) or reference point (translating wall)
+  double speed = 0.0;  // rad/s at full speed (drum)
   double ramp_time = 0.0;
-  double angle0 = 0.0;   // rad, angle at t = 0
-  Vec2 velocity{};       // m/s, translation (walls)
+  double angle0 = 0.0;  // rad, angle at t = 0
+  Vec2 velocity{};      // m/s, translation (walls)
   // State at the current time (set by Walls::update).
   double omega = 0.0;
   double angle = 0.0;
-  Vec2 offset{};         // translation since t = 0
+  Vec2 offset{};  // translation since t = 0
 };
 
 enum class WallKind { kCircle, kSegment };
@@ -36,7 +36,7 @@ struct WallElement {
   WallKind kind = WallKind::kSegment;
   int body = 0;
   int material = 0;
-  double radius = 0.0;  // circle
+  double radius = 0.0;    // circle
   Vec2 a_ref{}, b_ref{};  // segment ends in the body frame (relative to the body's centre)
   Vec2 a{}, b{};          // segment ends in the lab frame at the current time
 };
@@ -61,7 +61,8 @@ class Walls {
     const WallElement& e = elements_[element];
     if (e.kind == WallKind::kCircle) {
       const double inner = e.radius - r;
-      return inner <= 0.0 || !(norm2(x - (bodies_[e.body].center + bodies_[e.body].offset)) <= inner * inner);
+      return inner <= 0.0 ||
+             !(norm2(x - (bodies_[e.body].center + bodies_[e.body].offset)) <= inner * inner);
     }
     const Vec2 ab = e.b - e.a;
     const double len2 = norm2(ab);

@@ -139,7 +139,9 @@ Impact run_impact(Simulation& sim, const std::function<double(const ParticleStor
 }
 
 double floor_overlap(const ParticleStore& p) { return p.radius[0] - p.pos[0].y; }
-double pair_overlap(const ParticleStore& p) { return p.radius[0] + p.radius[1] - norm(p.pos[1] - p.pos[0]); }
+double pair_overlap(const ParticleStore& p) {
+  return p.radius[0] + p.radius[1] - norm(p.pos[1] - p.pos[0]);
+}
 
 void expect_rel(double value, double reference, double tol, const std::string& what) {
   EXPECT_NEAR(value, reference, tol * std::abs(reference)) << what;
@@ -238,13 +240,15 @@ struct Rebound {
 
 Rebound test4_rebound(const Material& m, double incidence_deg) {
   const double r = 0.0025, speed = 3.9, mu = 0.092, e = 0.98;
-  const double v_n = speed * std::cos(incidence_deg * kDeg), v_t = speed * std::sin(incidence_deg * kDeg);
+  const double v_n = speed * std::cos(incidence_deg * kDeg),
+               v_t = speed * std::sin(incidence_deg * kDeg);
   const double t_c = hertz_time(mass_of(m, r), r, e_star_of(m), v_n);
   Simulation sim(sphere_on_plane(spec(m, e, mu), r, {v_t, -v_n}, 0.0, t_c / 1000.0));
   run_impact(sim, floor_overlap);
   const ParticleStore& p = sim.particles();
   // Contact-point tangential velocity: v_x + w r (the bottom point of a CCW ball moves +x).
-  return {p.vel[0].x / v_t, p.omega[0], std::atan((p.vel[0].x + p.omega[0] * r) / p.vel[0].y) / kDeg};
+  return {p.vel[0].x / v_t, p.omega[0],
+          std::atan((p.vel[0].x + p.omega[0] * r) / p.vel[0].y) / kDeg};
 }
 
 Rebound test4_formula(double incidence_deg) {
@@ -380,7 +384,8 @@ TEST(ChungOoi, Test7OppositeSpinsAreUnchangedAndNoTangentialVelocityAppears) {
       const double t_c = hertz_time(0.5 * mass_of(m, r), 0.5 * r, 0.5 * e_star_of(m), 2 * v);
       Scene s = base_scene(t_c / 500.0);
       s.materials = {spec(m, 0.5, 0.4)};
-      s.particles = {ball(m.name, r, {-r, 0.0}, {v, 0.0}, w0), ball(m.name, r, {r, 0.0}, {-v, 0.0}, -w0)};
+      s.particles = {ball(m.name, r, {-r, 0.0}, {v, 0.0}, w0),
+                     ball(m.name, r, {r, 0.0}, {-v, 0.0}, -w0)};
       Simulation sim(s);
       run_impact(sim, pair_overlap);
       const ParticleStore& p = sim.particles();
@@ -420,7 +425,8 @@ double test8_beta(const Material& m, double x) {
 TEST(ChungOoi, Test8SpinningSphereOnDenseBigSphereSlidingBranchBetaEqualsXMinusOne) {
   for (const Material& m : {kAlAlloy, kNylon}) {
     for (const double x : {0.2, 0.5, 0.8}) {
-      EXPECT_NEAR(test8_beta(m, x), x - 1.0, 0.01 * (1.0 - x)) << m.name << " x = " << x;  // issue: ~1 %
+      EXPECT_NEAR(test8_beta(m, x), x - 1.0, 0.01 * (1.0 - x))
+          << m.name << " x = " << x;  // issue: ~1 %
     }
   }
 }

@@ -94,8 +94,8 @@ struct ContactHistory {
   double m_roll = 0.0;
 };
 template <class Law>
-ContactForce law(const MaterialPair& c, const ContactKinematics& k, const ContactHistory& old, ContactHistory& h,
-                 double dt) {
+ContactForce law(const MaterialPair& c, const ContactKinematics& k, const ContactHistory& old,
+                 ContactHistory& h, double dt) {
   typename Law::template History<double> before{}, after{};
   if constexpr (Law::kHistory.size() == 1) before[0] = old.xi;
   const ContactForce f = Law::evaluate(Law::coeffs(c), k, before, after, dt);
@@ -121,7 +121,8 @@ PairCoeffs steel_pair(double restitution, double mu_s, double mu_r = 0.0) {
 }
 
 // Kinematics of two steel spheres of radius 0.05 m at overlap delta.
-ContactKinematics steel_kinematics(double delta, double v_n = 0.0, double v_t = 0.0, double w_rel = 0.0) {
+ContactKinematics steel_kinematics(double delta, double v_n = 0.0, double v_t = 0.0,
+                                   double w_rel = 0.0) {
   const double r = 0.05;
   const double m = sphere_mass(r, 7800.0);
   ContactKinematics k;
@@ -149,7 +150,8 @@ TEST(PairTable, EffectiveModuliFollowPhysicsMdAndCoefficientsAreMeans) {
   const PairTable table(s);
   const PairCoeffs& c = table(0, 1);
   const double e_star = 1.0 / ((1 - 0.25 * 0.25) / 2.0e11 + (1 - 0.30 * 0.30) / 6.0e10);
-  const double g_star = 1.0 / (2 * (2 - 0.25) * (1 + 0.25) / 2.0e11 + 2 * (2 - 0.30) * (1 + 0.30) / 6.0e10);
+  const double g_star =
+      1.0 / (2 * (2 - 0.25) * (1 + 0.25) / 2.0e11 + 2 * (2 - 0.30) * (1 + 0.30) / 6.0e10);
   EXPECT_NEAR(c.e_star, e_star, 1e-12 * e_star);
   EXPECT_NEAR(c.g_star, g_star, 1e-12 * g_star);
   EXPECT_DOUBLE_EQ(c.restitution, 0.6);
@@ -212,7 +214,8 @@ TEST(HertzMindlinLaw, ApproachingRaisesTheNormalForceByTheDashpot) {
   const double f_el = hertz_force(c, k.r_eff, k.delta);
   const double s_n = 2.0 * c.e_star * std::sqrt(k.r_eff * k.delta);
   const double beta = hertz_beta_for_restitution(0.5);
-  const double expected = f_el - 2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(s_n * k.m_eff) * k.v_n;
+  const double expected =
+      f_el - 2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(s_n * k.m_eff) * k.v_n;
   EXPECT_GT(f.f_n, f_el);
   EXPECT_NEAR(f.f_n, expected, 1e-12 * expected);
   EXPECT_GT(f.dissipated, 0.0);  // the dashpot dissipates while closing
@@ -263,8 +266,10 @@ TEST(HertzMindlinLaw, TangentialSpringIsMinusStTimesXiWithXiIncrementedByVtDt) {
   EXPECT_NEAR(f.f_t, -s_t * xi, 1e-12 * s_t * xi);
   ASSERT_LT(std::abs(f.f_t), c.mu_s * f.f_n);  // below the cap
   // Stored energy of both springs.
-  EXPECT_NEAR(f.elastic, 8.0 / 15.0 * c.e_star * std::sqrt(k.r_eff) * std::pow(delta, 2.5) + 0.5 * s_t * xi * xi,
-              1e-12 * f.elastic);
+  EXPECT_NEAR(
+      f.elastic,
+      8.0 / 15.0 * c.e_star * std::sqrt(k.r_eff) * std::pow(delta, 2.5) + 0.5 * s_t * xi * xi,
+      1e-12 * f.elastic);
 }
 
 TEST(HertzMindlinLaw, TangentialSpringOpposesNegativeSlipToo) {
@@ -283,7 +288,8 @@ TEST(HertzMindlinLaw, TangentialDashpotIsTwoSqrtFiveSixthsBetaSqrtStMstar) {
   const ContactForce f = law<HertzMindlin>(c, k, {}, h, 0.0);  // dt = 0: spring unchanged
   const double s_t = 8.0 * c.g_star * std::sqrt(k.r_eff * delta);
   const double beta = hertz_beta_for_restitution(0.5);
-  const double expected = 2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(s_t * k.m_eff) * v_t;  // beta < 0
+  const double expected =
+      2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(s_t * k.m_eff) * v_t;  // beta < 0
   ASSERT_LT(std::abs(f.f_t), c.mu_s * f.f_n);
   EXPECT_EQ(h.xi, 0.0);
   EXPECT_NEAR(f.f_t, expected, 1e-12 * std::abs(expected));
@@ -330,7 +336,8 @@ TEST(ThesisLaw, NormalForceIsHertzPlusZetaDamping) {
   ContactHistory h;
   const ContactForce f = law<ThesisModel>(c, k, {}, h, 1.0e-6);
   const double s_n = 2.0 * c.e_star * std::sqrt(k.r_eff * k.delta);
-  const double expected = hertz_force(c, k.r_eff, k.delta) + 2.0 * 0.1 * std::sqrt(k.m_eff * s_n) * 0.2;  // T11, T22
+  const double expected =
+      hertz_force(c, k.r_eff, k.delta) + 2.0 * 0.1 * std::sqrt(k.m_eff * s_n) * 0.2;  // T11, T22
   EXPECT_NEAR(f.f_n, expected, 1e-12 * expected);
   EXPECT_DOUBLE_EQ(f.f_t, 0.0);
   // Clamped at zero while separating fast.
@@ -348,8 +355,9 @@ TEST(ThesisLaw, TangentialForceIsCoulombOpposingSlipPlusViscous) {
     const ContactKinematics k = steel_kinematics(1.0e-5, 0.0, v_t);
     ContactHistory h;
     const ContactForce f = law<ThesisModel>(c, k, {}, h, 1.0e-6);
-    const double c_t = 4.0 * 0.2 * std::sqrt(k.m_eff * 2.0 * c.g_star * std::sqrt(k.r_eff * k.delta));  // T23
-    const double expected = -0.1 * f.f_n * sign(v_t) - c_t * v_t;                                     // T13
+    const double c_t =
+        4.0 * 0.2 * std::sqrt(k.m_eff * 2.0 * c.g_star * std::sqrt(k.r_eff * k.delta));  // T23
+    const double expected = -0.1 * f.f_n * sign(v_t) - c_t * v_t;                        // T13
     EXPECT_NEAR(f.f_t, expected, 1e-12 * std::abs(expected));
     EXPECT_EQ(sign(f.f_t), -sign(v_t));
   }
@@ -361,7 +369,8 @@ TEST(ThesisLaw, TangentialForceIsCoulombOpposingSlipPlusViscous) {
 TEST(RollingLaw, NoneGivesNoTorque) {
   const PairCoeffs c = steel_pair(1.0, 0.3, 0.1);
   ContactHistory h;
-  const RollingTorque rt = rolling<RollingNone>(c, steel_kinematics(1e-5, 0, 0, 3.0), ContactForce{100.0, 0.0, 1e8}, {}, h, 1e-6, 0.3);
+  const RollingTorque rt = rolling<RollingNone>(c, steel_kinematics(1e-5, 0, 0, 3.0),
+                                                ContactForce{100.0, 0.0, 1e8}, {}, h, 1e-6, 0.3);
   EXPECT_EQ(rt.torque, 0.0);
 }
 
@@ -371,11 +380,13 @@ TEST(RollingLaw, ConstantTorqueIsMuRFnRstarOpposingRelativeSpin) {
   ContactHistory h;
   for (const double w : {+2.0, -2.0}) {
     const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
-    const RollingTorque rt = rolling<RollingConstant>(c, k, ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
+    const RollingTorque rt =
+        rolling<RollingConstant>(c, k, ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
     EXPECT_NEAR(rt.torque, -0.1 * f_n * k.r_eff * sign(w), 1e-14);
     EXPECT_GT(rt.dissipated, 0.0);
   }
-  const RollingTorque rest = rolling<RollingConstant>(c, steel_kinematics(1e-5), ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
+  const RollingTorque rest = rolling<RollingConstant>(
+      c, steel_kinematics(1e-5), ContactForce{f_n, 0.0, 0.0}, {}, h, 1e-6, 0.0);
   EXPECT_EQ(rest.torque, 0.0);
 }
 
@@ -386,7 +397,8 @@ TEST(RollingLaw, EpsdSpringGrowsByKrOmegaDtOpposingRelativeSpin) {
     const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
     const double k_r = 2.25 * k_n * 0.1 * 0.1 * k.r_eff * k.r_eff;
     ContactHistory old, h;
-    const RollingTorque rt = rolling<RollingEpsd>(c, k, ContactForce{f_n, 0.0, k_n}, old, h, dt, 0.0);  // eta_r = 0
+    const RollingTorque rt =
+        rolling<RollingEpsd>(c, k, ContactForce{f_n, 0.0, k_n}, old, h, dt, 0.0);  // eta_r = 0
     EXPECT_NEAR(h.m_roll, -k_r * w * dt, 1e-12 * k_r * std::abs(w) * dt);
     EXPECT_NEAR(rt.torque, -k_r * w * dt, 1e-12 * k_r * std::abs(w) * dt);
     // A second step adds the same increment.
@@ -419,7 +431,8 @@ TEST(RollingLaw, EpsdTorqueCapsAtMuRRstarFn) {
   EXPECT_GT(rt.dissipated, 0.0);
   // Reversing the spin unloads the spring below the cap (elastic again).
   ContactHistory back;
-  const RollingTorque r2 = rolling<RollingEpsd>(c, steel_kinematics(1e-5, 0.0, 0.0, -w), ContactForce{f_n, 0.0, k_n}, hist, back, dt, 0.0);
+  const RollingTorque r2 = rolling<RollingEpsd>(c, steel_kinematics(1e-5, 0.0, 0.0, -w),
+                                                ContactForce{f_n, 0.0, k_n}, hist, back, dt, 0.0);
   EXPECT_NEAR(back.m_roll, -cap + k_r * w * dt, 1e-9 * cap);
   EXPECT_NEAR(r2.torque, back.m_roll, 1e-9 * cap);
 }
@@ -430,7 +443,8 @@ TEST(RollingLaw, EpsdDashpotOpposesRelativeSpinBelowTheCap) {
   const ContactKinematics k = steel_kinematics(1e-5, 0.0, 0.0, w);
   const double k_r = 2.25 * k_n * 0.1 * 0.1 * k.r_eff * k.r_eff;
   ContactHistory h;
-  const RollingTorque rt = rolling<RollingEpsd>(c, k, ContactForce{f_n, 0.0, k_n}, {}, h, 0.0, eta);  // dt = 0: spring unchanged
+  const RollingTorque rt = rolling<RollingEpsd>(c, k, ContactForce{f_n, 0.0, k_n}, {}, h, 0.0,
+                                                eta);  // dt = 0: spring unchanged
   EXPECT_EQ(h.m_roll, 0.0);
   EXPECT_NEAR(rt.torque, -eta * 2.0 * std::sqrt(k.i_eff * k_r) * w, 1e-12 * std::abs(rt.torque));
   EXPECT_LT(rt.torque, 0.0);
@@ -476,7 +490,8 @@ TEST(ContactDirections, BallPressedOnAnotherIsPushedAwayAlongTheLineOfCentres) {
   Simulation sim(t.scene);  // the constructor evaluates the forces at the initial state
   const ParticleStore& p = sim.particles();
   const double r_eff = r0 * r1 / (r0 + r1);
-  const double f_n = 4.0 / 3.0 * sim.pair_table()(0, 0).e_star * std::sqrt(r_eff) * std::pow(delta, 1.5);
+  const double f_n =
+      4.0 / 3.0 * sim.pair_table()(0, 0).e_star * std::sqrt(r_eff) * std::pow(delta, 1.5);
   EXPECT_NEAR(p.force[0].x, -f_n * n.x, 1e-6 * f_n);
   EXPECT_NEAR(p.force[0].y, -f_n * n.y, 1e-6 * f_n);
   EXPECT_NEAR(p.force[1].x, f_n * n.x, 1e-6 * f_n);
@@ -507,7 +522,8 @@ TEST(ContactDirections, BallPressedOnFloorIsPushedUp) {
   OnFloor t;
   t.add(0.05, 1.0e-5);
   Simulation sim(t.scene);
-  const double f_n = 4.0 / 3.0 * sim.pair_table()(0, 1).e_star * std::sqrt(0.05) * std::pow(1.0e-5, 1.5);
+  const double f_n =
+      4.0 / 3.0 * sim.pair_table()(0, 1).e_star * std::sqrt(0.05) * std::pow(1.0e-5, 1.5);
   EXPECT_NEAR(sim.particles().force[0].y, f_n, 1e-6 * f_n);
   EXPECT_NEAR(sim.particles().force[0].x, 0.0, 1e-9 * f_n);
   EXPECT_EQ(sim.particles().torque[0], 0.0);
@@ -537,7 +553,8 @@ TEST(ContactDirections, TangentialHistoryIsDeletedWhenTheContactEnds) {
   EXPECT_GT(sim.wall_pairs().history[0], 0.0);
   for (int s = 0; s < 100; ++s) sim.step();
   ASSERT_EQ(sim.last_totals().contacts, 0);
-  for (std::size_t k = 0; k < sim.wall_pairs().size(); ++k) EXPECT_EQ(sim.wall_pairs().history[k], 0.0);
+  for (std::size_t k = 0; k < sim.wall_pairs().size(); ++k)
+    EXPECT_EQ(sim.wall_pairs().history[k], 0.0);
 }
 
 TEST(ContactDirections, BallSlidingRightOnFloorGetsFrictionLeftAndClockwiseSpinThatMakesItRoll) {
@@ -750,7 +767,8 @@ TEST(ContactDirections, BallOnTranslatingWallMovingLeftIsDraggedLeft) {
 // A drum of radius R about the origin with one ball resting on its shell at polar angle phi.
 struct InDrum {
   Scene scene;
-  InDrum(double speed, int sides = 0, RollingModelKind rolling = RollingModelKind::kNone, double mu_r = 0.0)
+  InDrum(double speed, int sides = 0, RollingModelKind rolling = RollingModelKind::kNone,
+         double mu_r = 0.0)
       : scene(base_scene(ContactModelKind::kHertzMindlin, rolling)) {
     scene.materials = {steel(1.0, 0.3, mu_r), rigid_like(steel(1.0, 0.3, mu_r))};
     scene.drum.present = true;
@@ -759,12 +777,15 @@ struct InDrum {
     scene.drum.sides = sides;
     scene.drum.material = "rigid";
   }
-  // Ball of radius r touching the shell (circle, or the inscribed circle of a polygon) at angle phi.
+  // Ball of radius r touching the shell (circle, or the inscribed circle of a polygon) at angle
+  // phi.
   void add(double r, double phi, double delta, Vec2 v = {}, double spin = 0.0) {
-    const double inner = scene.drum.sides == 0 ? scene.drum.radius
-                                               : scene.drum.radius * std::cos(kPi / scene.drum.sides);
+    const double inner = scene.drum.sides == 0
+                             ? scene.drum.radius
+                             : scene.drum.radius * std::cos(kPi / scene.drum.sides);
     const double rho = inner - r + delta;
-    scene.particles.push_back(ball("steel", r, {rho * std::cos(phi), rho * std::sin(phi)}, v, spin));
+    scene.particles.push_back(
+        ball("steel", r, {rho * std::cos(phi), rho * std::sin(phi)}, v, spin));
   }
 };
 
@@ -863,7 +884,8 @@ Scene head_on_scene(bool track_peak_energy) {
   Scene s = base_scene(ContactModelKind::kHertzMindlin, RollingModelKind::kEpsd, 1.0e-7);
   s.contact.track_peak_energy = track_peak_energy;
   s.materials = {steel(1.0, 0.0, 0.1)};
-  s.particles = {ball("steel", 0.05, {-0.0501, 0.0}, {1.0, 0.0}), ball("steel", 0.05, {0.0501, 0.0}, {-1.0, 0.0})};
+  s.particles = {ball("steel", 0.05, {-0.0501, 0.0}, {1.0, 0.0}),
+                 ball("steel", 0.05, {0.0501, 0.0}, {-1.0, 0.0})};
   return s;
 }
 

@@ -59,7 +59,8 @@ void expect_valid_packing(const Scene& s, const ParticleStore& p, const Walls& w
     for (std::size_t b = a + 1; b < p.size(); ++b)
       ASSERT_GE(norm(p.pos[a] - p.pos[b]), p.radius[a] + p.radius[b]) << "ids " << a << ", " << b;
     for (int e = 0; e < static_cast<int>(walls.elements().size()); ++e)
-      ASSERT_LE(walls.geometry(e, p.pos[a], p.radius[a]).delta, 1e-12) << "id " << a << " wall " << e;
+      ASSERT_LE(walls.geometry(e, p.pos[a], p.radius[a]).delta, 1e-12)
+          << "id " << a << " wall " << e;
     if (s.drum.present) {
       ASSERT_LE(norm(p.pos[a] - s.drum.center) + p.radius[a], s.drum.radius + 1e-12);
     }
@@ -109,8 +110,8 @@ TEST(Fill, FillFractionPolydisperseFullRegion) {
   EXPECT_EQ(static_cast<std::int64_t>(p.size()), fill_count(s, 0));
   EXPECT_GE(r_lo, 0.01);
   EXPECT_LE(r_hi, 0.03);
-  EXPECT_GT(r_hi - r_lo, 0.015);           // radii really are spread over the range
-  EXPECT_NEAR(y_mean, 0.0, 0.15);          // "full": spread over the whole drum, not at the bottom
+  EXPECT_GT(r_hi - r_lo, 0.015);   // radii really are spread over the range
+  EXPECT_NEAR(y_mean, 0.0, 0.15);  // "full": spread over the whole drum, not at the bottom
   expect_valid_packing(s, p, walls);
 }
 
@@ -233,12 +234,14 @@ TEST(PairCoefficients, InteractionOverridesTheMeanCoefficientByCoefficient) {
   EXPECT_DOUBLE_EQ(t(0, 1).mu_s, 0.9);
   EXPECT_DOUBLE_EQ(t(1, 0).mu_s, 0.9);
   EXPECT_DOUBLE_EQ(t(0, 1).restitution, 0.3);
-  EXPECT_DOUBLE_EQ(t(0, 1).mu_r, 0.04);   // not listed: the mean
-  EXPECT_DOUBLE_EQ(t(0, 2).mu_s, 0.3);    // pair not listed: the mean
+  EXPECT_DOUBLE_EQ(t(0, 1).mu_r, 0.04);  // not listed: the mean
+  EXPECT_DOUBLE_EQ(t(0, 2).mu_s, 0.3);   // pair not listed: the mean
   EXPECT_DOUBLE_EQ(t(1, 2).mu_s, 0.5);
   EXPECT_DOUBLE_EQ(t(2, 2).mu_s, 0.4);
   // The damping maps the pair's restitution (0.3), not the materials' (0.5).
-  EXPECT_NEAR(restitution_hertz_clamped(-HertzMindlin::coeffs(t(0, 1)).damp / (2.0 * std::sqrt(5.0 / 6.0))), 0.3, 1e-6);
+  EXPECT_NEAR(
+      restitution_hertz_clamped(-HertzMindlin::coeffs(t(0, 1)).damp / (2.0 * std::sqrt(5.0 / 6.0))),
+      0.3, 1e-6);
 }
 
 }  // namespace

@@ -11,11 +11,11 @@
 #include <utility>
 #include <vector>
 
-#include "support/thesis.hpp"
 #include "core/neighbors.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
 #include "core/walls.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {

@@ -18,9 +18,11 @@ double unclamped_beta(double e) {
 // is clamped at zero (Antypov & Elliott 2011; Thornton, Cummins & Cleary 2013).
 TEST(Restitution, ClampedHertzWithUnclampedBetaMatchesPublishedTable) {
   const double asked[] = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.98};
-  const double obtained[] = {0.2527, 0.3249, 0.3971, 0.4720, 0.5503, 0.6323, 0.7182, 0.8081, 0.9020, 0.9801};
+  const double obtained[] = {0.2527, 0.3249, 0.3971, 0.4720, 0.5503,
+                             0.6323, 0.7182, 0.8081, 0.9020, 0.9801};
   for (int k = 0; k < 10; ++k)
-    EXPECT_NEAR(restitution_hertz_clamped(unclamped_beta(asked[k])), obtained[k], 6e-5) << "e = " << asked[k];
+    EXPECT_NEAR(restitution_hertz_clamped(unclamped_beta(asked[k])), obtained[k], 6e-5)
+        << "e = " << asked[k];
 }
 
 TEST(Restitution, MappedBetaGivesBackTheAskedRestitution) {

@@ -18,11 +18,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kG = 9.81;
-constexpr double kR = 0.1;          // m, ball radius
-constexpr double kDensity = 7800;   // kg/m^3
-constexpr double kYoung = 2.0e11;   // Pa
+constexpr double kR = 0.1;         // m, ball radius
+constexpr double kDensity = 7800;  // kg/m^3
+constexpr double kYoung = 2.0e11;  // Pa
 constexpr double kNu = 0.25;
-constexpr double kDt = 2.0e-5;      // s: ~125 steps per normal and ~70 per tangential period
+constexpr double kDt = 2.0e-5;  // s: ~125 steps per normal and ~70 per tangential period
 
 MaterialSpec material(const std::string& name, double young, double mu_s, double mu_r) {
   MaterialSpec m;
@@ -45,7 +45,8 @@ struct Incline {
   double angle;
   Vec2 downhill, up_normal;
 
-  Incline(double t, double mu_s, double mu_r, RollingModelKind rolling, double v = 0.0, double w = 0.0)
+  Incline(double t, double mu_s, double mu_r, RollingModelKind rolling, double v = 0.0,
+          double w = 0.0)
       : angle(t), downhill{std::cos(t), -std::sin(t)}, up_normal{std::sin(t), std::cos(t)} {
     scene.title = "rolling test";
     scene.run.dt_auto = false;
@@ -61,7 +62,8 @@ struct Incline {
     scene.walls = {wall};
     const double m = 4.0 / 3.0 * kPi * kR * kR * kR * kDensity;
     const double e_star = kYoung / (1 - kNu * kNu);
-    const double delta = std::pow(m * kG * std::cos(t) / (4.0 / 3.0 * e_star * std::sqrt(kR)), 2.0 / 3.0);
+    const double delta =
+        std::pow(m * kG * std::cos(t) / (4.0 / 3.0 * e_star * std::sqrt(kR)), 2.0 / 3.0);
     ParticleSpec p;
     p.material = "steel";
     p.radius = kR;
@@ -79,7 +81,9 @@ struct Incline {
 
 // Rolling without slip on an incline (Ai et al. 2011, models A and C at full mobilisation):
 // a = 5/7 g (sin t - mu_r cos t), valid for tan t <= (7 mu_s - 5 mu_r) / 2.
-double rolling_acceleration(double t, double mu_r) { return 5.0 / 7.0 * kG * (std::sin(t) - mu_r * std::cos(t)); }
+double rolling_acceleration(double t, double mu_r) {
+  return 5.0 / 7.0 * kG * (std::sin(t) - mu_r * std::cos(t));
+}
 
 // ---------------------------------------------------------------------------------------------
 
@@ -127,7 +131,8 @@ TEST(Rolling, SphereRollsDownInclineAtFiveSeventhsGSinMinusMuRCos_ConstantModel_
     const double t = deg * kPi / 180.0;
     ASSERT_LE(std::tan(t), (7 * mu_s - 5 * mu_r) / 2);  // rolls without slip
     const double expected = rolling_acceleration(t, mu_r);
-    EXPECT_NEAR(incline_acceleration(t, mu_s, mu_r, RollingModelKind::kConstant), expected, 0.02 * expected)
+    EXPECT_NEAR(incline_acceleration(t, mu_s, mu_r, RollingModelKind::kConstant), expected,
+                0.02 * expected)
         << deg << " deg";
   }
 }
@@ -137,7 +142,8 @@ TEST(Rolling, SphereRollsDownInclineAtFiveSeventhsGSinMinusMuRCos_EpsdModel_AiEt
   for (const double deg : {10.0, 20.0, 35.0}) {
     const double t = deg * kPi / 180.0;
     const double expected = rolling_acceleration(t, mu_r);
-    EXPECT_NEAR(incline_acceleration(t, mu_s, mu_r, RollingModelKind::kEpsd), expected, 0.02 * expected)
+    EXPECT_NEAR(incline_acceleration(t, mu_s, mu_r, RollingModelKind::kEpsd), expected,
+                0.02 * expected)
         << deg << " deg";
   }
 }
@@ -145,7 +151,8 @@ TEST(Rolling, SphereRollsDownInclineAtFiveSeventhsGSinMinusMuRCos_EpsdModel_AiEt
 TEST(Rolling, SphereOnInclineWithoutRollingResistanceRollsAtFiveSeventhsGSin) {
   const double t = 20.0 * kPi / 180.0;
   const double expected = rolling_acceleration(t, 0.0);
-  EXPECT_NEAR(incline_acceleration(t, 0.5, 0.0, RollingModelKind::kNone), expected, 0.02 * expected);
+  EXPECT_NEAR(incline_acceleration(t, 0.5, 0.0, RollingModelKind::kNone), expected,
+              0.02 * expected);
 }
 
 TEST(Rolling, EpsdSphereOnInclineFlatterThanMuRStaysAtRest_AiEtAl2011) {
@@ -186,7 +193,8 @@ TEST(Rolling, EpsdSphereRollingDownInclineFlatterThanMuRDeceleratesAndComesToRes
     t_prev = sim.time();
   }
   EXPECT_NEAR(t_stop, t1 + v1 / std::abs(a), 0.01 * (v1 / std::abs(a)));
-  EXPECT_NEAR(inc.distance(sim) - x1, v1 * v1 / (2 * std::abs(a)), 0.01 * v1 * v1 / (2 * std::abs(a)));
+  EXPECT_NEAR(inc.distance(sim) - x1, v1 * v1 / (2 * std::abs(a)),
+              0.01 * v1 * v1 / (2 * std::abs(a)));
   EXPECT_LT(norm(sim.particles().vel[0]), 1e-6);
   EXPECT_LT(std::abs(sim.particles().omega[0]) * kR, 1e-6);
 }

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "support/thesis.hpp"
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {

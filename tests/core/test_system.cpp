@@ -23,9 +23,9 @@
 #include <numbers>
 #include <vector>
 
-#include "support/thesis.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {

@@ -129,8 +129,8 @@ TEST(Decks, LiftersLiftTheChargeThatASmoothShellLetsSlip) {
   Scene without = with;
   without.drum.lifters.clear();
   const double a_with = charge_angle(with), a_without = charge_angle(without);
-  std::cout << "charge centre of mass angle: with lifters " << a_with << " deg, without " << a_without
-            << " deg\n";
+  std::cout << "charge centre of mass angle: with lifters " << a_with << " deg, without "
+            << a_without << " deg\n";
   // Measured: about 50 deg with lifters, 16 deg without (the block slips and rocks).
   EXPECT_GT(a_with, 40.0);
   EXPECT_LT(a_without, 20.0);
