@@ -30,39 +30,48 @@ struct HistoryColumns {
   std::array<Array<double>, kMaxHistorySlots> old, fresh;
 };
 
-struct ContactBatch {
-  // Inputs (phase A).
-  Array<std::int32_t> pair;   // index into the pair list
+// What both batches share: the contact's list index and material pair, the history columns, and
+// sizing and padding driven by the derived batch's two column lists, `inputs()` (what phase B
+// reads: copied into the padding lanes) and `outputs()`.
+template <class Derived>
+struct BatchColumns {
+  Array<std::int32_t> pair;   // index into the list
   Array<std::int32_t> coeff;  // material pair index into the coefficient table
-  Array<double> dx, dy;       // x_j - x_i
-  Array<double> dist2;        // |x_j - x_i|^2
-  Array<double> r_i, r_j, m_i, m_j;
-  Array<double> vx, vy;     // v_i - v_j
-  Array<double> spin;       // w_i r_i + w_j r_j
-  Array<double> omega_rel;  // w_i - w_j
-  Array<double> counted;    // 1: this rank books the contact's energies and count, 0: not
   HistoryColumns history;
-  // Outputs (phase B).
-  Array<double> fx, fy;    // force on i (on j: the opposite)
-  Array<double> t_i, t_j;  // torques on i and on j
-  Array<double> overlap;   // delta / min(r_i, r_j)
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
-    for (auto* v : inputs()) v->resize(n);
-    for (auto* v : {&fx, &fy, &t_i, &t_j, &overlap}) v->resize(n);
-    for (auto& v : history.fresh) v.resize(n);
+    for (Array<double>* v : self().inputs()) v->resize(n);
+    for (Array<double>* v : self().outputs()) v->resize(n);
+    for (Array<double>& v : history.fresh) v.resize(n);
     pair.resize(n);
     coeff.resize(n);
   }
   // Copy contact `from` into slot `to` (padding).
   void copy(std::size_t to, std::size_t from) {
-    for (auto* v : inputs()) (*v)[to] = (*v)[from];
+    for (Array<double>* v : self().inputs()) (*v)[to] = (*v)[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];
   }
 
  private:
+  Derived& self() { return static_cast<Derived&>(*this); }
+};
+
+struct ContactBatch : BatchColumns<ContactBatch> {
+  // Inputs (phase A).
+  Array<double> dx, dy;  // x_j - x_i
+  Array<double> dist2;   // |x_j - x_i|^2
+  Array<double> r_i, r_j, m_i, m_j;
+  Array<double> vx, vy;     // v_i - v_j
+  Array<double> spin;       // w_i r_i + w_j r_j
+  Array<double> omega_rel;  // w_i - w_j
+  Array<double> counted;    // 1: this rank books the contact's energies and count, 0: not
+  // Outputs (phase B).
+  Array<double> fx, fy;    // force on i (on j: the opposite)
+  Array<double> t_i, t_j;  // torques on i and on j
+  Array<double> overlap;   // delta / min(r_i, r_j)
+
   std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
     return {&dx,
             &dy,
@@ -81,44 +90,24 @@ struct ContactBatch {
             &history.old[2],
             &history.old[3]};
   }
+  std::array<Array<double>*, 5> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap}; }
 };
 
 // The particle-wall contacts of one force evaluation, in the same three phases: the geometry
 // (closest point, normal, wall velocity) is found in the scalar gather, the law runs on packs,
 // and the scatter adds forces, energies, drive power and drum torque in wall-list order.
-struct WallBatch {
+struct WallBatch : BatchColumns<WallBatch> {
   // Inputs (phase A).
-  Array<std::int32_t> pair;     // index into the wall pair list
-  Array<std::int32_t> coeff;    // material pair index into the coefficient table
   Array<double> delta, nx, ny;  // overlap; unit normal from the sphere towards the wall
   Array<double> r, m;
   Array<double> vx, vy;     // v_rel = (v_i - v_wall) + w_i r_i t
   Array<double> omega_rel;  // w_i - Omega_wall
-  Array<double> wx, wy;     // wall velocity at the contact point
-  Array<double> px, py;     // contact point
-  HistoryColumns history;
+  Array<double> wx, wy;     // wall velocity at the contact point (scatter only)
+  Array<double> px, py;     // contact point (scatter only)
   // Outputs (phase B).
   Array<double> fx, fy, torque, m_roll;
   Array<double> diss_law, el_law, diss_roll, el_roll;
 
-  void reserve(std::size_t n) {
-    if (pair.size() >= n) return;
-    for (auto* v : inputs()) v->resize(n);
-    for (auto* v :
-         {&wx, &wy, &px, &py, &fx, &fy, &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll})
-      v->resize(n);
-    for (auto& v : history.fresh) v.resize(n);
-    pair.resize(n);
-    coeff.resize(n);
-  }
-  void copy(std::size_t to, std::size_t from) {
-    for (auto* v : inputs()) (*v)[to] = (*v)[from];
-    pair[to] = pair[from];
-    coeff[to] = coeff[from];
-  }
-
- private:
-  // What phase B reads (copied into the padding lanes).
   std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
     return {&delta,
             &nx,
@@ -132,6 +121,10 @@ struct WallBatch {
             &history.old[1],
             &history.old[2],
             &history.old[3]};
+  }
+  std::array<Array<double>*, 12> outputs() {
+    return {&wx,     &wy,     &px,       &py,     &fx,        &fy,
+            &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll};
   }
 };
 

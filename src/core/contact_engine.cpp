@@ -86,6 +86,21 @@ class Kernel final : public ContactKernel {
     return Model::gather(coeffs_.data(), index);
   }
 
+  // The contact model on the pack of contacts [c, c + kPackSize) of a batch: coefficients of
+  // each lane's material pair, the history read from the batch and the advanced one written
+  // back. The one evaluation both paths share.
+  template <class Batch>
+  [[gnu::always_inline]] ContactResponseT<Pack> respond(Batch& batch, std::size_t c,
+                                                        const KinematicsT<Pack>& kin,
+                                                        double dt) const {
+    typename Model::template History<Pack> h;
+    const auto pc = coeffs_of([&](auto l) { return batch.coeff[c + l]; });
+    const ContactResponseT<Pack> out =
+        Model::evaluate(pc, kin, load_history<Model>(batch.history, c), h, dt);
+    store_history<Model>(h, batch.history, c);
+    return out;
+  }
+
   void pair_contacts(ParticleStore& p, PairList& pl, double dt, EvaluationTotals& tot);
   std::size_t gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1);
   void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
@@ -215,10 +230,7 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     const Pack spin = load(b_.spin, c);
     project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
     kin.omega_rel = load(b_.omega_rel, c);
-    typename Model::template History<Pack> h;
-    const auto pc = coeffs_of([&](auto l) { return b_.coeff[c + l]; });
-    const ContactResponseT<Pack> out =
-        Model::evaluate(pc, kin, load_history<Model>(b_.history, c), h, dt);
+    const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
     const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : ri;
@@ -243,7 +255,6 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     store(fy, b_.fy, c);
     store(ti, b_.t_i, c);
     store(tj, b_.t_j, c);
-    store_history<Model>(h, b_.history, c);
     store(ratio, b_.overlap, c);
   }
 }
@@ -334,10 +345,7 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     if constexpr (Model::Rolling::kNeedsInertia) kin.i_eff = 1.4 * mi * ri * ri;
     project_velocity(kin, load(wb_.vx, c), load(wb_.vy, c), nx, ny);
     kin.omega_rel = load(wb_.omega_rel, c);
-    typename Model::template History<Pack> h;
-    const auto pc = coeffs_of([&](auto l) { return wb_.coeff[c + l]; });
-    const ContactResponseT<Pack> out =
-        Model::evaluate(pc, kin, load_history<Model>(wb_.history, c), h, dt);
+    const ContactResponseT<Pack> out = respond(wb_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
     Pack ti = ri * cf.f_t;
@@ -350,7 +358,6 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     store(cf.elastic, wb_.el_law, c);
     store(out.rolling.dissipated, wb_.diss_roll, c);
     store(out.rolling.elastic, wb_.el_roll, c);
-    store_history<Model>(h, wb_.history, c);
   }
 }
 

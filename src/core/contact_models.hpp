@@ -134,6 +134,13 @@ template <class T, class M>
   out.elastic = out.elastic + 0.5 * k_t * xi_new * xi_new;
 }
 
+// A sub-model that carries nothing from step to step.
+struct NoHistory {
+  static constexpr std::array<HistorySlot, 0> kHistory{};
+  template <class T>
+  using History = HistoryArray<T, 0>;
+};
+
 // The tangential spring's one history slot (hertz-mindlin, linear).
 inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
     {{"xi", "m", "tangential spring elongation"}}};
@@ -195,12 +202,9 @@ struct HertzMindlin {
 // F_s = mu_s F_n sign(v_t) (T13) plus tangential damping c_t = 4 zeta_t sqrt(m* 2 G* sqrt(R*
 // delta)) (T23), torques with the arm R* (T15). Normal force clamped at zero like the others. No
 // history. Strain energy (breakage): k_n delta^2 / 2 (T35).
-struct ThesisModel {
+struct ThesisModel : NoHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kThesis;
   static constexpr bool kTorqueArmIsReff = true;
-  static constexpr std::array<HistorySlot, 0> kHistory{};
-  template <class T>
-  using History = HistoryArray<T, 0>;
   template <class V>
   struct Coeffs {
     V e_star{}, g_star{}, mu_s{}, zeta_n{}, zeta_t{};
@@ -286,13 +290,10 @@ struct LinearModel {
 // Rolling models
 
 // No rolling resistance: nothing is computed, nothing stored.
-struct RollingNone {
+struct RollingNone : NoHistory {
   static constexpr RollingModelKind kKind = RollingModelKind::kNone;
   static constexpr bool kActive = false;
   static constexpr bool kNeedsInertia = false;
-  static constexpr std::array<HistorySlot, 0> kHistory{};
-  template <class T>
-  using History = HistoryArray<T, 0>;
   template <class V>
   struct Coeffs {
     template <class S>
@@ -310,13 +311,10 @@ struct RollingNone {
 };
 
 // Constant directional torque (T16; Ai et al. 2011 model A): M = -mu_r F_n R* sign(w_rel).
-struct RollingConstant {
+struct RollingConstant : NoHistory {
   static constexpr RollingModelKind kKind = RollingModelKind::kConstant;
   static constexpr bool kActive = true;
   static constexpr bool kNeedsInertia = false;
-  static constexpr std::array<HistorySlot, 0> kHistory{};
-  template <class T>
-  using History = HistoryArray<T, 0>;
   template <class V>
   struct Coeffs {
     V mu_r{};
@@ -409,10 +407,7 @@ using RollingModels = std::tuple<RollingNone, RollingConstant, RollingEpsd>;
 // ---------------------------------------------------------------------------------------------
 // Trackers: what a contact records for models outside the force law.
 
-struct TrackNone {
-  static constexpr std::array<HistorySlot, 0> kHistory{};
-  template <class T>
-  using History = HistoryArray<T, 0>;
+struct TrackNone : NoHistory {
   template <class T>
   [[gnu::always_inline]] static void evaluate(const ContactForceT<T>&, const History<T>&,
                                               History<T>&) {}

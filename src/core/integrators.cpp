@@ -43,8 +43,7 @@ double accelerations(ParticleStore& p, Vec2 gravity) {
   double checksum = 0.0;
 #pragma omp simd reduction(+ : checksum)
   for (std::size_t k = 0; k < n; ++k) {
-    a[k] = inv_m[k] * f[k] + gravity;
-    al[k] = inv_i[k] * tq[k];
+    accelerate(a[k], al[k], f[k], tq[k], inv_m[k], inv_i[k], gravity);
     checksum += (a[k].x + a[k].y) + al[k];
   }
   return checksum;
@@ -108,8 +107,7 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
   double checksum = 0.0, disp2 = 0.0, speed2 = 0.0;
 #pragma omp simd reduction(+ : checksum) reduction(max : disp2, speed2)
   for (std::size_t k = 0; k < n; ++k) {
-    a[k] = inv_m[k] * f[k] + g;
-    al[k] = inv_i[k] * tq[k];
+    accelerate(a[k], al[k], f[k], tq[k], inv_m[k], inv_i[k], g);
     checksum += (a[k].x + a[k].y) + al[k] + (x[k].x + x[k].y);
     v[k] += h * a[k];
     w[k] += h * al[k];

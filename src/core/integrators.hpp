@@ -116,8 +116,15 @@ class Integrator {
 
 std::unique_ptr<Integrator> make_integrator(const RunSpec& run, double dt, Vec2 gravity);
 
-// a = F/m + g and alpha = M/I for the owned particles, gravity added last, the same way for
-// every particle. Returns a checksum (a plain sum: any NaN or infinity makes it non-finite).
+// a = F/m + g and alpha = M/I of one particle, gravity added last, the same way for every
+// particle.
+[[gnu::always_inline]] inline void accelerate(Vec2& a, double& alpha, Vec2 f, double torque,
+                                              double inv_m, double inv_i, Vec2 gravity) {
+  a = inv_m * f + gravity;
+  alpha = inv_i * torque;
+}
+// The same for the owned particles. Returns a checksum (a plain sum: any NaN or infinity makes
+// it non-finite).
 double accelerations(ParticleStore& p, Vec2 gravity);
 
 // Velocity Verlet's opening half kick and drift of one particle. The same operations serve the
