@@ -142,8 +142,12 @@ struct NoHistory {
 };
 
 // The tangential spring's one history slot (hertz-mindlin, linear).
-inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
-    {{"xi", "m", "tangential spring elongation"}}};
+struct TangentialSpringHistory {
+  static constexpr std::array<HistorySlot, 1> kHistory{
+      {{"xi", "m", "tangential spring elongation"}}};
+  template <class T>
+  using History = HistoryArray<T, 1>;
+};
 
 // ---------------------------------------------------------------------------------------------
 // Laws
@@ -153,12 +157,9 @@ inline constexpr std::array<HistorySlot, 1> kTangentialSpringHistory{
 //   S_t = 8 G* sqrt(R* delta), F_t = -S_t xi - 2 sqrt(5/6) beta sqrt(S_t m*) v_t, |F_t| <= mu_s
 //   F_n, beta mapped from the restitution asked for the clamped law (materials.hpp).
 // Strain energy (breakage): the Hertz energy 8/15 E* sqrt(R*) delta^2.5.
-struct HertzMindlin {
+struct HertzMindlin : TangentialSpringHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kHertzMindlin;
   static constexpr bool kTorqueArmIsReff = false;
-  static constexpr auto kHistory = kTangentialSpringHistory;
-  template <class T>
-  using History = HistoryArray<T, kHistory.size()>;
   template <class V>
   struct Coeffs {
     V e_star{}, g_star{}, mu_s{};
@@ -243,12 +244,9 @@ struct ThesisModel : NoHistory {
 // c_n = 2 gamma sqrt(k_n m*) with gamma mapped from the restitution for the clamped law,
 // k_t = 2/7 k_n (equal normal and tangential periods for a sphere), c_t = 2 gamma sqrt(k_t m*).
 // Strain energy (breakage): k_n delta^2 / 2.
-struct LinearModel {
+struct LinearModel : TangentialSpringHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kLinear;
   static constexpr bool kTorqueArmIsReff = false;
-  static constexpr auto kHistory = kTangentialSpringHistory;
-  template <class T>
-  using History = HistoryArray<T, kHistory.size()>;
   template <class V>
   struct Coeffs {
     V mu_s{};

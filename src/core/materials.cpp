@@ -59,6 +59,15 @@ double invert_restitution(double e, F restitution_of, double hi) {
   return 0.5 * (lo + hi);
 }
 
+// f(e), computed once per value of e (each inversion costs tens of milliseconds; a scene asks
+// for the same few restitutions again and again). One cache per function.
+template <class F>
+double cached(std::map<double, double>& cache, std::mutex& mutex, double e, F f) {
+  std::lock_guard<std::mutex> lock(mutex);
+  if (auto it = cache.find(e); it != cache.end()) return it->second;
+  return cache[e] = f(e);
+}
+
 double mean_or(const std::optional<double>& v, double a, double b) {
   return v ? *v : 0.5 * (a + b);
 }
@@ -72,12 +81,9 @@ double restitution_hertz_clamped(double beta) {
 double hertz_beta_for_restitution(double e) {
   static std::mutex mutex;
   static std::map<double, double> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (auto it = cache.find(e); it != cache.end()) return it->second;
-  const double eta = invert_restitution(e, hertz_clamped, 4.0);
-  const double beta = -eta / std::sqrt(5.0);
-  cache[e] = beta;
-  return beta;
+  return cached(cache, mutex, e, [](double x) {
+    return -invert_restitution(x, hertz_clamped, 4.0) / std::sqrt(5.0);
+  });
 }
 
 double restitution_linear_clamped(double gamma) { return linear_clamped(2.0 * gamma); }
@@ -85,11 +91,8 @@ double restitution_linear_clamped(double gamma) { return linear_clamped(2.0 * ga
 double linear_gamma_for_restitution(double e) {
   static std::mutex mutex;
   static std::map<double, double> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (auto it = cache.find(e); it != cache.end()) return it->second;
-  const double eta = invert_restitution(e, linear_clamped, 4.0);
-  cache[e] = 0.5 * eta;
-  return 0.5 * eta;
+  return cached(cache, mutex, e,
+                [](double x) { return 0.5 * invert_restitution(x, linear_clamped, 4.0); });
 }
 
 PairTable::PairTable(const Scene& scene) : n_(static_cast<int>(scene.materials.size())) {
