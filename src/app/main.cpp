@@ -66,7 +66,8 @@ void print_check(const Simulation& sim) {
   if (!s.title.empty()) out += "  title:                 " + s.title + "\n";
   out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
   double area = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) area += std::numbers::pi * p.radius[k] * p.radius[k];
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    area += std::numbers::pi * p.radius[k] * p.radius[k];
   const double g = norm(s.run.gravity);
   if (s.drum.present) {
     const double R = s.drum.radius;
@@ -85,7 +86,8 @@ void print_check(const Simulation& sim) {
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
   out += fmt_double("  smallest restitution:  %.3f", ts.restitution_min) +
-         fmt_double(" -> Hertz contact resolved with %.0f steps (1 %% restitution)\n", ts.steps_per_contact);
+         fmt_double(" -> Hertz contact resolved with %.0f steps (1 %% restitution)\n",
+                    ts.steps_per_contact);
   out += fmt_double("  safe dt:               %.4e s (dt = \"auto\")", ts.safe_dt) +
          fmt_double("; refused above %.4e s\n", ts.limit_dt);
   out += fmt_double("  chosen dt:             %.4e s", sim.dt()) +
@@ -93,8 +95,9 @@ void print_check(const Simulation& sim) {
   const double steps = std::ceil(s.run.duration / sim.dt() - 0.5);
   out += fmt_double("  steps:                 %.0f", steps) +
          fmt_double(" for %.4g s simulated\n", s.run.duration);
-  const double bytes = static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
-                       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);
+  const double bytes =
+      static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
+      static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);
   out += fmt_double("  memory estimate:       %.1f MiB\n", 2.0 * bytes / (1024.0 * 1024.0));
   out += fmt_double("  neighbour skin:        %.4g m\n", sim.skin());
   say(out);
@@ -103,8 +106,12 @@ void print_check(const Simulation& sim) {
 class Progress {
  public:
   Progress(bool quiet, double duration, double interval)
-      : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), duration_(duration), interval_(interval),
-        start_(Clock::now()), last_(start_) {}
+      : quiet_(quiet),
+        tty_(isatty(STDERR_FILENO) != 0),
+        duration_(duration),
+        interval_(interval),
+        start_(Clock::now()),
+        last_(start_) {}
   void update(const Simulation& sim, std::int64_t n_particles, bool final_line = false) {
     if (quiet_ || g_rank != 0) return;
     const auto now = Clock::now();
@@ -137,7 +144,8 @@ int run(const Options& opt) {
   Scene scene = load_deck(opt.deck, opt.sets);
   if (!opt.output.empty()) scene.output.directory = opt.output;
   if (!opt.restart.empty())
-    throw InputError("--restart " + opt.restart + ": error: restarting from a checkpoint is not implemented yet");
+    throw InputError("--restart " + opt.restart +
+                     ": error: restarting from a checkpoint is not implemented yet");
   // The angular-sector decomposition about the drum centre (the particles' centre without a
   // drum); on one rank its verbs are trivial.
   DecompositionOptions decomposition;
@@ -160,9 +168,10 @@ int run(const Options& opt) {
   } catch (const IoError& e) {
     // An output directory that cannot be written is bad input (exit 2), named by its key;
     // a write that fails later (disk full) stays an I/O failure (exit 4).
-    const std::string source = opt.output.empty() ? scene.deck_path + ": error: output.directory = '" +
-                                                        out.directory + "': "
-                                                  : "--output " + opt.output + ": error: ";
+    const std::string source =
+        opt.output.empty()
+            ? scene.deck_path + ": error: output.directory = '" + out.directory + "': "
+            : "--output " + opt.output + ": error: ";
     throw InputError(source + e.what() + "; give a directory you can write to");
   }
   // Rank 0 alone writes series.csv; every write is agreed on, so a failure there (disk full)
@@ -172,7 +181,8 @@ int run(const Options& opt) {
     std::string error;
     try {
       series_file = std::make_unique<SeriesWriter>(
-          out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative, g_rank == 0);
+          out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative,
+          g_rank == 0);
     } catch (const IoError& e) {
       error = e.what();
     }
@@ -228,7 +238,8 @@ int run(const Options& opt) {
         stderr);
     return kExitUnstable;
   }
-  if (last_snapshot_time != sim.time()) snapshots.write(sim.particles(), sim.time(), sim.step_count());
+  if (last_snapshot_time != sim.time())
+    snapshots.write(sim.particles(), sim.time(), sim.step_count());
   if (!at_multiple(sim.time(), out.series_interval)) write_row(sim.diagnostics());
   progress.update(sim, n_global, true);
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
@@ -242,8 +253,9 @@ int run(const Options& opt) {
   info.dt = sim.dt();
   info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
   if (scene.run.integrator == IntegratorKind::kIterative) {
-    info.extra.emplace_back("mean_passes", fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
-                                                                  std::max<std::int64_t>(1, sim.step_count())));
+    info.extra.emplace_back("mean_passes",
+                            fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
+                                                   std::max<std::int64_t>(1, sim.step_count())));
     info.extra.emplace_back("unconverged_steps", std::to_string(sim.unconverged_steps()));
   }
   {
@@ -275,10 +287,12 @@ int run(const Options& opt) {
   }
   if (g_rank == 0) write_run_json(out.directory + "/run.json", scene, info);
   if (!opt.quiet)
-    say(fmt_double("done: %.4g s simulated", sim.time()) + fmt_double(" in %.3g s of wall time", wall) +
+    say(fmt_double("done: %.4g s simulated", sim.time()) +
+        fmt_double(" in %.3g s of wall time", wall) +
         fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
   if (sim.unconverged_steps() > 0)
-    say("warning: the iterative integrator did not converge in " + std::to_string(sim.unconverged_steps()) +
+    say("warning: the iterative integrator did not converge in " +
+            std::to_string(sim.unconverged_steps()) +
             " steps (run.max_passes = " + std::to_string(scene.run.max_passes) + ")\n",
         stderr);
   return kExitOk;

@@ -54,8 +54,12 @@ class Field final : public FieldBase {
   std::size_t bytes_per_item() const override { return sizeof(T); }
   void resize(std::size_t n) override { data_.resize(n); }
   void copy_item(std::size_t dst, std::size_t src) override { data_[dst] = data_[src]; }
-  void pack(std::size_t i, std::byte* out) const override { std::memcpy(out, &data_[i], sizeof(T)); }
-  void unpack(std::size_t i, const std::byte* in) override { std::memcpy(&data_[i], in, sizeof(T)); }
+  void pack(std::size_t i, std::byte* out) const override {
+    std::memcpy(out, &data_[i], sizeof(T));
+  }
+  void unpack(std::size_t i, const std::byte* in) override {
+    std::memcpy(&data_[i], in, sizeof(T));
+  }
   std::byte* pack_items(std::span<const std::int32_t> idx, std::byte* out) const override {
     for (const std::int32_t i : idx) {
       std::memcpy(out, &data_[static_cast<std::size_t>(i)], sizeof(T));

@@ -34,7 +34,8 @@ std::byte* pack_fields(std::span<FieldBase* const> fields, std::size_t i, std::b
   return out;
 }
 
-const std::byte* unpack_fields(std::span<FieldBase* const> fields, std::size_t i, const std::byte* in) {
+const std::byte* unpack_fields(std::span<FieldBase* const> fields, std::size_t i,
+                               const std::byte* in) {
   for (FieldBase* f : fields) {
     f->unpack(i, in);
     in += f->bytes_per_item();
@@ -79,7 +80,8 @@ std::int64_t MpiDomain::sum(std::int64_t x) const {
 
 void MpiDomain::max(std::span<double> values) const {
   if (size_ == 1 || values.empty()) return;
-  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE, MPI_MAX,
+                comm_);
 }
 
 bool MpiDomain::any(bool x) const {
@@ -104,7 +106,8 @@ void MpiDomain::agree(const std::string& local_error) const {
 }
 
 int MpiDomain::owner_of(Vec2 x) const {
-  return partition_.owner[static_cast<std::size_t>(sector_of(x, options_.center, partition_.n_sectors))];
+  return partition_
+      .owner[static_cast<std::size_t>(sector_of(x, options_.center, partition_.n_sectors))];
 }
 
 void MpiDomain::rebuild_wedges() {
@@ -124,7 +127,8 @@ void MpiDomain::repartition(const ParticleStore& p) {
   const int n = options_.sectors_per_rank * size_;
   const double step = kTwoPi / n;
   std::vector<Vec2> ray(static_cast<std::size_t>(n) + 1);  // unit direction of boundary ray s
-  for (int s = 0; s <= n; ++s) ray[static_cast<std::size_t>(s)] = {std::cos(s * step), std::sin(s * step)};
+  for (int s = 0; s <= n; ++s)
+    ray[static_cast<std::size_t>(s)] = {std::cos(s * step), std::sin(s * step)};
   std::vector<double> weights(2 * static_cast<std::size_t>(n), 0.0);  // work, then boundaries
   const bool have_work = particle_work_.size() == p.n_owned();
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
@@ -133,11 +137,13 @@ void MpiDomain::repartition(const ParticleStore& p) {
     // Boundary ray s lies between sectors s - 1 and s: edge s - 1; ray s + 1: edge s.
     if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s)]) < halo_width_)
       weights[static_cast<std::size_t>(n + (s + n - 1) % n)] += 1.0;
-    if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s) + 1]) < halo_width_)
+    if (distance_to_ray(p.pos[k], options_.center, ray[static_cast<std::size_t>(s) + 1]) <
+        halo_width_)
       weights[static_cast<std::size_t>(n + s)] += 1.0;
   }
   std::vector<double> total(weights.size());
-  MPI_Allreduce(weights.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM, comm_);
+  MPI_Allreduce(weights.data(), total.data(), static_cast<int>(total.size()), MPI_DOUBLE, MPI_SUM,
+                comm_);
   const std::span<const double> work(total.data(), static_cast<std::size_t>(n));
   const std::span<const double> edges(total.data() + n, static_cast<std::size_t>(n));
   std::vector<int> owner(static_cast<std::size_t>(n));
@@ -161,9 +167,11 @@ void MpiDomain::repartition(const ParticleStore& p) {
   for (int s = 0; s < n; ++s) {
     const int q = owner[static_cast<std::size_t>(s)];
     part.arcs[static_cast<std::size_t>(q)].count += 1;
-    if (owner[static_cast<std::size_t>((s + n - 1) % n)] != q) part.arcs[static_cast<std::size_t>(q)].first = s;
+    if (owner[static_cast<std::size_t>((s + n - 1) % n)] != q)
+      part.arcs[static_cast<std::size_t>(q)].first = s;
   }
-  if (!is_valid(part)) throw std::logic_error("MpiDomain: the sector partition is not one arc per rank");
+  if (!is_valid(part))
+    throw std::logic_error("MpiDomain: the sector partition is not one arc per rank");
   partition_ = std::move(part);
   rebuild_wedges();
   stats_.partitions += 1;
@@ -222,7 +230,8 @@ void MpiDomain::report_work(std::span<const double> particle_work) {
 
 std::vector<int> MpiDomain::ghost_origin() const {
   std::vector<int> out;
-  for (std::size_t u = 0; u < halo_.peers.size(); ++u) out.insert(out.end(), halo_.recv_count[u], halo_.peers[u]);
+  for (std::size_t u = 0; u < halo_.peers.size(); ++u)
+    out.insert(out.end(), halo_.recv_count[u], halo_.peers[u]);
   return out;
 }
 
@@ -248,10 +257,12 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
     // Without a repartition a particle leaves only by crossing into a neighbour's wedge: it
     // was a ghost there if it is still within the halo width of this rank's wedge.
     if (!repartitioned && error.tellp() == 0) {
-      const double d = distance_to_wedge(p.pos[k], options_.center, wedge_begin_[rank_], wedge_end_[rank_]);
+      const double d =
+          distance_to_wedge(p.pos[k], options_.center, wedge_begin_[rank_], wedge_end_[rank_]);
       if (d > halo_width_)
-        error << "particle " << p.id[k] << " moved " << d << " m beyond the region of rank " << rank_
-              << " between two neighbour rebuilds (more than the halo width " << halo_width_
+        error << "particle " << p.id[k] << " moved " << d << " m beyond the region of rank "
+              << rank_ << " between two neighbour rebuilds (more than the halo width "
+              << halo_width_
               << " m): the time step is far too large or the particle left the scene";
     }
   }
@@ -278,9 +289,11 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   };
   for (std::size_t r = 0; r < histories.size(); ++r) {
     int da = -1, db = -1;
-    if (auto it = dest_of_leaving.find(histories.a(r)); it != dest_of_leaving.end()) da = it->second;
+    if (auto it = dest_of_leaving.find(histories.a(r)); it != dest_of_leaving.end())
+      da = it->second;
     if (histories.b(r) >= 0)
-      if (auto it = dest_of_leaving.find(histories.b(r)); it != dest_of_leaving.end()) db = it->second;
+      if (auto it = dest_of_leaving.find(histories.b(r)); it != dest_of_leaving.end())
+        db = it->second;
     if (da >= 0) send_record(da, r);
     if (db >= 0 && db != da) send_record(db, r);
   }
@@ -288,8 +301,11 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
 
   // Counts, then the bytes (particles and records in one all-to-all each).
   const auto exchange = [&](const std::vector<std::vector<std::byte>>& out) {
-    std::vector<long long> send_n(static_cast<std::size_t>(size_)), recv_n(static_cast<std::size_t>(size_));
-    for (int q = 0; q < size_; ++q) send_n[static_cast<std::size_t>(q)] = static_cast<long long>(out[static_cast<std::size_t>(q)].size());
+    std::vector<long long> send_n(static_cast<std::size_t>(size_)),
+        recv_n(static_cast<std::size_t>(size_));
+    for (int q = 0; q < size_; ++q)
+      send_n[static_cast<std::size_t>(q)] =
+          static_cast<long long>(out[static_cast<std::size_t>(q)].size());
     MPI_Alltoall(send_n.data(), 1, MPI_LONG_LONG, recv_n.data(), 1, MPI_LONG_LONG, comm_);
     std::vector<int> sc(static_cast<std::size_t>(size_)), sd(static_cast<std::size_t>(size_)),
         rc(static_cast<std::size_t>(size_)), rd(static_cast<std::size_t>(size_));
@@ -308,8 +324,8 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
       total += static_cast<std::size_t>(recv_n[u]);
     }
     flat_recv.resize(total);
-    MPI_Alltoallv(flat_send.data(), sc.data(), sd.data(), MPI_BYTE, flat_recv.data(), rc.data(), rd.data(),
-                  MPI_BYTE, comm_);
+    MPI_Alltoallv(flat_send.data(), sc.data(), sd.data(), MPI_BYTE, flat_recv.data(), rc.data(),
+                  rd.data(), MPI_BYTE, comm_);
     return flat_recv;
   };
   const std::vector<std::byte> arrived = exchange(send_particles);
@@ -320,11 +336,13 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   p.remove_if(leaving);
   const std::size_t n_new = arrived.size() / bpp;
   const std::size_t first = p.add_owned(n_new);
-  for (std::size_t k = 0; k < n_new; ++k) unpack_fields(p.fields(), first + k, arrived.data() + k * bpp);
+  for (std::size_t k = 0; k < n_new; ++k)
+    unpack_fields(p.fields(), first + k, arrived.data() + k * bpp);
   if (!std::is_sorted(p.id.data(), p.id.data() + p.n_owned())) {
     std::vector<std::size_t> order(p.n_owned());
     for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
     p.permute(order);
   }
   histories.unpack_append(arrived_records.data(), arrived_records.size());
@@ -333,8 +351,8 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   const std::int64_t total = sum(static_cast<std::int64_t>(p.n_owned()));
   if (total != total_particles_) {
     std::ostringstream o;
-    o << "migration lost or duplicated particles: " << total << " owned after it, " << total_particles_
-      << " before (rank count " << size_ << ")";
+    o << "migration lost or duplicated particles: " << total << " owned after it, "
+      << total_particles_ << " before (rank count " << size_ << ")";
     throw std::logic_error(o.str());
   }
 }
@@ -351,14 +369,14 @@ void MpiDomain::transport(const Plan& plan, std::size_t header_bytes, std::size_
     recv[u].resize(header_bytes + plan.recv_count[u] * bytes_per_item);
     if (recv[u].empty()) continue;
     req.emplace_back();
-    MPI_Irecv(recv[u].data(), static_cast<int>(recv[u].size()), MPI_BYTE, plan.peers[u], kTagHalo, comm_,
-              &req.back());
+    MPI_Irecv(recv[u].data(), static_cast<int>(recv[u].size()), MPI_BYTE, plan.peers[u], kTagHalo,
+              comm_, &req.back());
   }
   for (std::size_t u = 0; u < np; ++u) {
     if (send[u].empty()) continue;
     req.emplace_back();
-    MPI_Isend(send[u].data(), static_cast<int>(send[u].size()), MPI_BYTE, plan.peers[u], kTagHalo, comm_,
-              &req.back());
+    MPI_Isend(send[u].data(), static_cast<int>(send[u].size()), MPI_BYTE, plan.peers[u], kTagHalo,
+              comm_, &req.back());
   }
   MPI_Waitall(static_cast<int>(req.size()), req.data(), MPI_STATUSES_IGNORE);
 }
@@ -370,10 +388,14 @@ void MpiDomain::exchange_halo(ParticleStore& p) {
   std::vector<std::vector<std::int32_t>> to(static_cast<std::size_t>(size_));
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     for (int q = 0; q < size_; ++q)
-      if (q != rank_ && distance_to_wedge(p.pos[k], options_.center, wedge_begin_[q], wedge_end_[q]) < halo_width_)
+      if (q != rank_ && distance_to_wedge(p.pos[k], options_.center, wedge_begin_[q],
+                                          wedge_end_[q]) < halo_width_)
         to[static_cast<std::size_t>(q)].push_back(static_cast<std::int32_t>(k));
-  std::vector<long long> send_n(static_cast<std::size_t>(size_)), recv_n(static_cast<std::size_t>(size_));
-  for (int q = 0; q < size_; ++q) send_n[static_cast<std::size_t>(q)] = static_cast<long long>(to[static_cast<std::size_t>(q)].size());
+  std::vector<long long> send_n(static_cast<std::size_t>(size_)),
+      recv_n(static_cast<std::size_t>(size_));
+  for (int q = 0; q < size_; ++q)
+    send_n[static_cast<std::size_t>(q)] =
+        static_cast<long long>(to[static_cast<std::size_t>(q)].size());
   MPI_Alltoall(send_n.data(), 1, MPI_LONG_LONG, recv_n.data(), 1, MPI_LONG_LONG, comm_);
   halo_ = Plan{};
   all_peers_ = size_ <= kAllPeersRanks;
@@ -385,7 +407,8 @@ void MpiDomain::exchange_halo(ParticleStore& p) {
     halo_.recv_count.push_back(static_cast<std::size_t>(recv_n[u]));
   }
   halo_sources_.clear();
-  for (const auto& list : halo_.send) halo_sources_.insert(halo_sources_.end(), list.begin(), list.end());
+  for (const auto& list : halo_.send)
+    halo_sources_.insert(halo_sources_.end(), list.begin(), list.end());
   std::sort(halo_sources_.begin(), halo_sources_.end());
   halo_sources_.erase(std::unique(halo_sources_.begin(), halo_sources_.end()), halo_sources_.end());
   std::size_t n_ghost = 0;
@@ -448,7 +471,8 @@ void MpiDomain::fill_ghosts(ParticleStore& p, std::span<FieldBase* const> send_f
       double theirs;
       std::memcpy(&theirs, in + v * sizeof(double), sizeof(double));
       // Order-independent maximum that keeps a NaN from any rank.
-      if (std::isnan(theirs) || theirs > values[v]) values[v] = std::isnan(values[v]) ? values[v] : theirs;
+      if (std::isnan(theirs) || theirs > values[v])
+        values[v] = std::isnan(values[v]) ? values[v] : theirs;
     }
     in += header;
     for (FieldBase* f : recv_fields) in = f->unpack_items(slot, halo_.recv_count[u], in);

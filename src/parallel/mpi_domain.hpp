@@ -53,30 +53,32 @@
 namespace dem2d {
 
 struct DecompositionOptions {
-  Vec2 center{};                      // sectors are cut about this point (the drum centre)
-  bool has_center = false;            // false: the centre of the particles' bounding box
+  Vec2 center{};            // sectors are cut about this point (the drum centre)
+  bool has_center = false;  // false: the centre of the particles' bounding box
   // 32: bench/partition finds that contiguous arcs of 16 sectors per rank cannot balance a
   // settled charge within 5 % from 4 ranks up (granularity), 24 can, and from 32 METIS's
   // own grouping is mostly kept.
   int sectors_per_rank = 32;
-  double repartition_threshold = 1.05; // max/mean work that triggers a repartition
-  int repartition_gap = 10;           // rebuilds between two partitions at least
+  double repartition_threshold = 1.05;  // max/mean work that triggers a repartition
+  int repartition_gap = 10;             // rebuilds between two partitions at least
 };
 
 // What the decomposition did, for run.json and bench/strong_scaling.
 struct DecompositionStats {
-  int partitions = 0;                 // METIS partitions computed (1 = the initial one)
-  std::string method;                 // how the last partition was found
-  double imbalance_work = 1.0;        // max/mean of the last reported work
-  double imbalance_sum = 0.0;         // sum of imbalance_work over the rebuilds so far
-  std::int64_t reports = 0;           // rebuilds reported
-  double imbalance_mean() const { return reports ? imbalance_sum / static_cast<double>(reports) : 1.0; }
-  double imbalance_equal_angle = 1.0; // the same for equal-angle arcs at the last partition
-  double imbalance_partition = 1.0;   // predicted (sector weights) at the last partition
-  std::int64_t migrated = 0;          // particles sent by this rank, all rebuilds
-  std::int64_t ghosts = 0;            // ghosts on this rank after the last halo exchange
-  double comm_seconds = 0.0;          // wall time in migrate / exchange_halo / refresh_ghosts
-  double work = 0.0;                  // this rank's last reported work
+  int partitions = 0;           // METIS partitions computed (1 = the initial one)
+  std::string method;           // how the last partition was found
+  double imbalance_work = 1.0;  // max/mean of the last reported work
+  double imbalance_sum = 0.0;   // sum of imbalance_work over the rebuilds so far
+  std::int64_t reports = 0;     // rebuilds reported
+  double imbalance_mean() const {
+    return reports ? imbalance_sum / static_cast<double>(reports) : 1.0;
+  }
+  double imbalance_equal_angle = 1.0;  // the same for equal-angle arcs at the last partition
+  double imbalance_partition = 1.0;    // predicted (sector weights) at the last partition
+  std::int64_t migrated = 0;           // particles sent by this rank, all rebuilds
+  std::int64_t ghosts = 0;             // ghosts on this rank after the last halo exchange
+  double comm_seconds = 0.0;           // wall time in migrate / exchange_halo / refresh_ghosts
+  double work = 0.0;                   // this rank's last reported work
 };
 
 class MpiDomain final : public Domain {
@@ -115,9 +117,9 @@ class MpiDomain final : public Domain {
  private:
   // Who sends what to whom: per peer rank, local indices to send and the count to receive.
   struct Plan {
-    std::vector<int> peers;                  // ranks exchanged with, ascending
+    std::vector<int> peers;                       // ranks exchanged with, ascending
     std::vector<std::vector<std::int32_t>> send;  // per peer: local indices
-    std::vector<std::size_t> recv_count;     // per peer
+    std::vector<std::size_t> recv_count;          // per peer
   };
   void repartition(const ParticleStore& p);
   void rebuild_wedges();
@@ -143,7 +145,7 @@ class MpiDomain final : public Domain {
   std::int64_t total_particles_ = 0;
   Plan halo_;
   std::vector<std::int32_t> halo_sources_;  // union of halo_.send, ascending
-  bool all_peers_ = false;                   // every other rank is in halo_.peers
+  bool all_peers_ = false;                  // every other rank is in halo_.peers
   std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
   std::vector<MPI_Request> requests_;
   std::vector<double> reduce_buffer_;  // exchange_step without all peers: values and NaN flags

@@ -62,7 +62,8 @@ void place_probe_particles(ParticleStore& p, int n_sectors) {
     const double a = s * kTwoPi / n_sectors;
     for (const double off : {-1e-9, 1e-9, -0.015, 0.015})
       for (const double rad : {0.05, 0.3, 0.93})
-        p.add(id++, 0, r, 7800.0, {rad * std::cos(a + off / rad), rad * std::sin(a + off / rad)}, {}, 0.0);
+        p.add(id++, 0, r, 7800.0, {rad * std::cos(a + off / rad), rad * std::sin(a + off / rad)},
+              {}, 0.0);
   }
   for (int k = 0; k < 40; ++k) {
     const double a = kTwoPi * (k + 0.5) / 40;
@@ -103,7 +104,8 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
   for (std::size_t k = p.n_owned(); k < p.size(); ++k) ghosts.insert(p.id[k]);
   std::set<std::int64_t> want_owned, want_ghosts;
   for (std::size_t k = 0; k < all.n_owned(); ++k) {
-    const int owner = part.owner[static_cast<std::size_t>(sector_of(all.pos[k], {}, part.n_sectors))];
+    const int owner =
+        part.owner[static_cast<std::size_t>(sector_of(all.pos[k], {}, part.n_sectors))];
     if (owner == rank)
       want_owned.insert(all.id[k]);
     else if (distance_to_part(all.pos[k], {}, part, rank) < halo)
@@ -111,7 +113,8 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
   }
   EXPECT_EQ(owned, want_owned);
   EXPECT_EQ(ghosts, want_ghosts);
-  EXPECT_EQ(global_sum(static_cast<std::int64_t>(p.n_owned())), static_cast<std::int64_t>(all.n_owned()));
+  EXPECT_EQ(global_sum(static_cast<std::int64_t>(p.n_owned())),
+            static_cast<std::int64_t>(all.n_owned()));
   // The centre particle is on every rank, owned by one.
   const std::int64_t has_centre = owned.count(0) + ghosts.count(0);
   EXPECT_EQ(has_centre, 1);
@@ -122,7 +125,8 @@ TEST(Decomposition, OwnershipAndExactGhostSets) {
   for (std::size_t g = 0; g < p.n_ghost(); ++g) {
     const std::size_t k = p.n_owned() + g;
     const std::size_t src = static_cast<std::size_t>(p.id[k]);  // ids are indices in `all`
-    EXPECT_EQ(origin[g], part.owner[static_cast<std::size_t>(sector_of(all.pos[src], {}, part.n_sectors))]);
+    EXPECT_EQ(origin[g],
+              part.owner[static_cast<std::size_t>(sector_of(all.pos[src], {}, part.n_sectors))]);
     EXPECT_NE(origin[g], rank);
     EXPECT_EQ(std::memcmp(&p.pos[k], &all.pos[src], sizeof(Vec2)), 0);
     EXPECT_EQ(std::memcmp(&p.vel[k], &all.vel[src], sizeof(Vec2)), 0);
@@ -199,7 +203,8 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
   HistoryRecords records(2);
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Vec2 x = p.pos[k];
-    p.pos[k] = {x.x * std::cos(turn) - x.y * std::sin(turn), x.x * std::sin(turn) + x.y * std::cos(turn)};
+    p.pos[k] = {x.x * std::cos(turn) - x.y * std::sin(turn),
+                x.x * std::sin(turn) + x.y * std::cos(turn)};
     p.omega[k] = static_cast<double>(p.id[k]);
     p.theta[k] = rank;
     // A history with the next particle and one with wall element 3, keyed by this id.
@@ -295,7 +300,8 @@ TEST(Decomposition, AJumpPastTheHaloIsAnErrorOnEveryRank) {
   } catch (const std::runtime_error& e) {
     what = e.what();
   }
-  EXPECT_NE(what.find("particle " + std::to_string(1 + 12 * ((16 * size + 2) / 3) + 20)), std::string::npos)
+  EXPECT_NE(what.find("particle " + std::to_string(1 + 12 * ((16 * size + 2) / 3) + 20)),
+            std::string::npos)
       << "every rank names the particle: '" << what << "'";
   EXPECT_NE(what.find("halo"), std::string::npos) << what;
 }
@@ -323,7 +329,8 @@ Mismatch compare_to_serial(const Simulation& par, const Simulation& ser) {
                     same(a.omega[k], b.omega[s]) && same(a.alpha[k], b.alpha[s]);
     if (!ok) {
       if (m.count == 0)
-        m.first = "particle " + std::to_string(a.id[k]) + " at step " + std::to_string(par.step_count());
+        m.first =
+            "particle " + std::to_string(a.id[k]) + " at step " + std::to_string(par.step_count());
       ++m.count;
     }
   }
@@ -362,9 +369,11 @@ void expect_same_as_serial(const Scene& scene, int steps, int every) {
   const std::int64_t migrated = global_sum(domain.stats().migrated);
   if (world_size() > 1) EXPECT_GT(migrated, 0) << "the scene should move particles between ranks";
   if (world_rank() == 0)
-    std::printf("[ reproducible ] %s: %d steps, %lld comparisons, %lld migrations, %d partitions, imbalance %.3f\n",
-                scene.title.c_str(), steps, static_cast<long long>(checked), static_cast<long long>(migrated),
-                domain.stats().partitions, domain.stats().imbalance_work);
+    std::printf(
+        "[ reproducible ] %s: %d steps, %lld comparisons, %lld migrations, %d partitions, "
+        "imbalance %.3f\n",
+        scene.title.c_str(), steps, static_cast<long long>(checked),
+        static_cast<long long>(migrated), domain.stats().partitions, domain.stats().imbalance_work);
 }
 
 Scene thesis_drum(int balls, double speed, int sides) {
@@ -417,8 +426,9 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
   s.deck_path = "test_domain";
   s.materials.push_back(thesis_steel());
   s.run.dt_auto = true;
-  for (const auto& [a, b] : {std::pair{Vec2{-0.4, 0.0}, Vec2{0.4, 0.0}}, std::pair{Vec2{-0.4, 0.0}, Vec2{-0.4, 0.6}},
-                             std::pair{Vec2{0.4, 0.0}, Vec2{0.4, 0.6}}}) {
+  for (const auto& [a, b] :
+       {std::pair{Vec2{-0.4, 0.0}, Vec2{0.4, 0.0}}, std::pair{Vec2{-0.4, 0.0}, Vec2{-0.4, 0.6}},
+        std::pair{Vec2{0.4, 0.0}, Vec2{0.4, 0.6}}}) {
     WallSpec w;
     w.from = a;
     w.to = b;
