@@ -199,7 +199,11 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
   // Turn every owned particle by 1/4 sector counter-clockwise (less than the halo at these
   // radii), and mark it: spin = its id, angle = the rank it started on.
   const double turn = 0.25 * kTwoPi / (16 * size);
-  std::map<std::int64_t, int> started_on;
+  // The rank each particle starts on (ids are indices in `all`).
+  ParticleStore all;
+  place_probe_particles(all, 16 * size);
+  std::vector<int> started_on(all.n_owned());
+  for (std::size_t k = 0; k < all.n_owned(); ++k) started_on[k] = domain.owner_of(all.pos[k]);
   HistoryRecords records(2);
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Vec2 x = p.pos[k];
@@ -228,6 +232,12 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
       return std::ptrdiff_t{-1};
     };
     EXPECT_GE(find(p.id[k], p.id[k] + 1), 0) << "id " << p.id[k];
+    // The record keyed by its predecessor travels with it too (as its second particle) when
+    // both started on the same rank, where that record was made.
+    const auto id = static_cast<std::size_t>(p.id[k]);
+    if (id > 0 && started_on[id - 1] == started_on[id]) {
+      EXPECT_GE(find(p.id[k] - 1, p.id[k]), 0) << "id " << p.id[k];
+    }
     const std::ptrdiff_t wall = find(p.id[k], -4);
     ASSERT_GE(wall, 0) << "id " << p.id[k];
     EXPECT_EQ(records.values(static_cast<std::size_t>(wall))[1], static_cast<double>(p.id[k]));
@@ -238,7 +248,9 @@ TEST(Decomposition, MigrationCarriesFieldsAndHistories) {
     sorted = sorted && (records.a(r - 1) < records.a(r) ||
                         (records.a(r - 1) == records.a(r) && records.b(r - 1) < records.b(r)));
   EXPECT_TRUE(sorted) << "records sorted by key, without repeats";
-  if (size > 1) EXPECT_GT(global_sum(moved_here), 0) << "the turn should move some particles";
+  if (size > 1) {
+    EXPECT_GT(global_sum(moved_here), 0) << "the turn should move some particles";
+  }
   EXPECT_EQ(global_sum(moved_here), domain.sum(domain.stats().migrated));
 }
 
@@ -367,7 +379,9 @@ void expect_same_as_serial(const Scene& scene, int steps, int every) {
   }
   EXPECT_EQ(global_sum(bad), 0) << "first mismatch on rank " << world_rank() << ": " << first;
   const std::int64_t migrated = global_sum(domain.stats().migrated);
-  if (world_size() > 1) EXPECT_GT(migrated, 0) << "the scene should move particles between ranks";
+  if (world_size() > 1) {
+    EXPECT_GT(migrated, 0) << "the scene should move particles between ranks";
+  }
   if (world_rank() == 0)
     std::printf(
         "[ reproducible ] %s: %d steps, %lld comparisons, %lld migrations, %d partitions, "
