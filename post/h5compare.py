@@ -6,8 +6,9 @@
 Within each snapshot both files' particles are sorted by id, so runs on different rank counts
 (whose files hold the particles in a different order) compare equal when the physics is the
 same. Compared: the number and names of snapshots, their time and step attributes, the set of
-ids, every per-particle dataset (id, position, velocity, spin, radius, material, and any extra
-field such as damage) and the /materials table. /xdmf (ParaView helper data) is ignored.
+ids, every per-particle dataset (id, material, position, velocity, angle, spin, radius: whatever
+the files hold; a dataset in one file only is a difference) and the /materials table. The
+datasets' unit and doc attributes and /xdmf (ParaView helper data) are not compared.
 
 Exit status: 0 when the files are bit-identical (or, with --atol, every floating-point value
 is within atol and everything else is identical); 1 otherwise, after printing the first

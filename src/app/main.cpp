@@ -19,12 +19,12 @@
 
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
-#include "io/agree.hpp"
 #include "io/deck.hpp"
 #include "io/output_dir.hpp"
 #include "io/run_json.hpp"
 #include "io/series.hpp"
 #include "io/snapshots.hpp"
+#include "parallel/comm.hpp"
 #include "parallel/mpi_domain.hpp"
 
 namespace {
@@ -36,7 +36,6 @@ struct Options {
   std::string deck;
   std::vector<std::string> sets;
   std::string output;
-  std::string restart;
   bool check = false;
   bool quiet = false;
 };
@@ -66,7 +65,8 @@ void print_check(const Simulation& sim) {
   if (!s.title.empty()) out += "  title:                 " + s.title + "\n";
   out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
   double area = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) area += std::numbers::pi * p.radius[k] * p.radius[k];
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    area += std::numbers::pi * p.radius[k] * p.radius[k];
   const double g = norm(s.run.gravity);
   if (s.drum.present) {
     const double R = s.drum.radius;
@@ -85,7 +85,8 @@ void print_check(const Simulation& sim) {
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
   out += fmt_double("  smallest restitution:  %.3f", ts.restitution_min) +
-         fmt_double(" -> Hertz contact resolved with %.0f steps (1 %% restitution)\n", ts.steps_per_contact);
+         fmt_double(" -> Hertz contact resolved with %.0f steps (1 %% restitution)\n",
+                    ts.steps_per_contact);
   out += fmt_double("  safe dt:               %.4e s (dt = \"auto\")", ts.safe_dt) +
          fmt_double("; refused above %.4e s\n", ts.limit_dt);
   out += fmt_double("  chosen dt:             %.4e s", sim.dt()) +
@@ -93,8 +94,9 @@ void print_check(const Simulation& sim) {
   const double steps = std::ceil(s.run.duration / sim.dt() - 0.5);
   out += fmt_double("  steps:                 %.0f", steps) +
          fmt_double(" for %.4g s simulated\n", s.run.duration);
-  const double bytes = static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
-                       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);
+  const double bytes =
+      static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
+      static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);
   out += fmt_double("  memory estimate:       %.1f MiB\n", 2.0 * bytes / (1024.0 * 1024.0));
   out += fmt_double("  neighbour skin:        %.4g m\n", sim.skin());
   say(out);
@@ -103,8 +105,12 @@ void print_check(const Simulation& sim) {
 class Progress {
  public:
   Progress(bool quiet, double duration, double interval)
-      : quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0), duration_(duration), interval_(interval),
-        start_(Clock::now()), last_(start_) {}
+      : quiet_(quiet),
+        tty_(isatty(STDERR_FILENO) != 0),
+        duration_(duration),
+        interval_(interval),
+        start_(Clock::now()),
+        last_(start_) {}
   void update(const Simulation& sim, std::int64_t n_particles, bool final_line = false) {
     if (quiet_ || g_rank != 0) return;
     const auto now = Clock::now();
@@ -133,92 +139,88 @@ class Progress {
   Clock::time_point start_, last_;
 };
 
-int run(const Options& opt) {
-  Scene scene = load_deck(opt.deck, opt.sets);
-  if (!opt.output.empty()) scene.output.directory = opt.output;
-  if (!opt.restart.empty())
-    throw InputError("--restart " + opt.restart + ": error: restarting from a checkpoint is not implemented yet");
-  // The angular-sector decomposition about the drum centre (the particles' centre without a
-  // drum); on one rank its verbs are trivial.
-  DecompositionOptions decomposition;
-  decomposition.has_center = scene.drum.present;
-  decomposition.center = scene.drum.center;
-  decomposition.sectors_per_rank = scene.run.sectors_per_rank;
-  decomposition.repartition_threshold = scene.run.repartition_threshold;
-  if (opt.check) {
-    // Every rank evaluates the whole scene alike; rank 0 prints.
-    const Simulation whole(scene);
-    print_check(whole);
-    return kExitOk;
-  }
-  MpiDomain domain(MPI_COMM_WORLD, decomposition);
-  Simulation sim(scene, &domain);
-  const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
-  const OutputSpec& out = scene.output;
+// The angular-sector decomposition about the drum centre (the particles' centre without a
+// drum); on one rank its verbs are trivial.
+DecompositionOptions decomposition_of(const Scene& scene) {
+  DecompositionOptions d;
+  d.has_center = scene.drum.present;
+  d.center = scene.drum.center;
+  d.sectors_per_rank = scene.run.sectors_per_rank;
+  d.repartition_threshold = scene.run.repartition_threshold;
+  return d;
+}
+
+// Collective. An output directory that cannot be written is bad input (exit 2), named by its
+// key; a write that fails later (disk full) stays an I/O failure (exit 4).
+void prepare_output(const Options& opt, const Scene& scene) {
+  const std::string& dir = scene.output.directory;
   try {
-    prepare_output_directory(MPI_COMM_WORLD, out.directory);
+    prepare_output_directory(MPI_COMM_WORLD, dir);
   } catch (const IoError& e) {
-    // An output directory that cannot be written is bad input (exit 2), named by its key;
-    // a write that fails later (disk full) stays an I/O failure (exit 4).
-    const std::string source = opt.output.empty() ? scene.deck_path + ": error: output.directory = '" +
-                                                        out.directory + "': "
-                                                  : "--output " + opt.output + ": error: ";
+    const std::string source = opt.output.empty()
+                                   ? scene.deck_path + ": error: output.directory = '" + dir + "': "
+                                   : "--output " + opt.output + ": error: ";
     throw InputError(source + e.what() + "; give a directory you can write to");
   }
-  // Rank 0 alone writes series.csv; every write is agreed on, so a failure there (disk full)
-  // stops every rank with the same message instead of leaving the others in a collective.
-  std::unique_ptr<SeriesWriter> series_file;
-  {
-    std::string error;
-    try {
-      series_file = std::make_unique<SeriesWriter>(
-          out.directory + "/series.csv", scene.run.integrator == IntegratorKind::kIterative, g_rank == 0);
-    } catch (const IoError& e) {
-      error = e.what();
-    }
-    throw_if_any_rank_failed(MPI_COMM_WORLD, error);
-  }
-  const auto write_row = [&](const SeriesRow& row) {
-    std::string error;
-    try {
-      series_file->write(row);
-    } catch (const IoError& e) {
-      error = e.what();
-    }
-    throw_if_any_rank_failed(MPI_COMM_WORLD, error);
-  };
-  SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
-  if (!opt.quiet)
-    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(n_global) +
-        " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
-        (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory + "\n");
+}
 
+// series.csv: rank 0 alone writes it; every write is agreed on, so a failure there (disk full)
+// stops every rank with the same message instead of leaving the others in a collective.
+class SeriesOutput {
+ public:
+  explicit SeriesOutput(const Scene& scene) {
+    std::string error;
+    try {
+      file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/series.csv",
+                                             scene.run.integrator == IntegratorKind::kIterative,
+                                             g_rank == 0);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+  }
+  void write(const SeriesRow& row) {
+    std::string error;
+    try {
+      file_->write(row);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+  }
+
+ private:
+  std::unique_ptr<SeriesWriter> file_;
+};
+
+// The time loop with its outputs: series rows and snapshots at their intervals, the first and
+// last state always. Returns false when the run became unstable, after writing a last
+// snapshot and reporting it.
+bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, SnapshotWriter& snapshots,
+             Progress& progress, std::int64_t n_global) {
+  const OutputSpec& out = scene.output;
   const double dt = sim.dt();
   const auto at_multiple = [dt](double t, double interval) {
     if (interval <= 0.0) return false;
     const double k = std::round(t / interval);
     return std::abs(t - k * interval) < 0.5 * dt;
   };
-  Progress progress(opt.quiet, scene.run.duration, out.progress_interval);
-  const auto start = Clock::now();
   double last_snapshot_time = -1.0;
-  write_row(sim.diagnostics());
-  sim.reset_pass_window();
-  if (out.snapshot_interval > 0) {
+  const auto snapshot = [&] {
     snapshots.write(sim.particles(), sim.time(), sim.step_count());
     last_snapshot_time = sim.time();
-  }
+  };
+  series.write(sim.diagnostics());
+  sim.reset_pass_window();
+  if (out.snapshot_interval > 0) snapshot();
   try {
     while (sim.time() + 0.5 * dt < scene.run.duration) {
       sim.step();
       if (at_multiple(sim.time(), out.series_interval)) {
-        write_row(sim.diagnostics());
+        series.write(sim.diagnostics());
         sim.reset_pass_window();
       }
-      if (at_multiple(sim.time(), out.snapshot_interval)) {
-        snapshots.write(sim.particles(), sim.time(), sim.step_count());
-        last_snapshot_time = sim.time();
-      }
+      if (at_multiple(sim.time(), out.snapshot_interval)) snapshot();
       progress.update(sim, n_global);
     }
   } catch (const UnstableError& e) {
@@ -226,12 +228,17 @@ int run(const Options& opt) {
     say(scene.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
             "/snapshots.h5\n",
         stderr);
-    return kExitUnstable;
+    return false;
   }
-  if (last_snapshot_time != sim.time()) snapshots.write(sim.particles(), sim.time(), sim.step_count());
-  if (!at_multiple(sim.time(), out.series_interval)) write_row(sim.diagnostics());
+  if (last_snapshot_time != sim.time()) snapshot();
+  if (!at_multiple(sim.time(), out.series_interval)) series.write(sim.diagnostics());
   progress.update(sim, n_global, true);
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  return true;
+}
+
+// Collective (the decomposition's per-rank figures are gathered): what run.json records.
+RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
+                 std::int64_t n_global, double wall) {
   RunInfo info;
   info.version = DEM2D_VERSION;
   info.ranks = g_size;
@@ -242,43 +249,66 @@ int run(const Options& opt) {
   info.dt = sim.dt();
   info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
   if (scene.run.integrator == IntegratorKind::kIterative) {
-    info.extra.emplace_back("mean_passes", fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
-                                                                  std::max<std::int64_t>(1, sim.step_count())));
+    info.extra.emplace_back("mean_passes",
+                            fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
+                                                   std::max<std::int64_t>(1, sim.step_count())));
     info.extra.emplace_back("unconverged_steps", std::to_string(sim.unconverged_steps()));
   }
-  {
-    // The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
-    // ghosts, migrations and time in communication; the imbalance against equal angles.
-    const DecompositionStats& ds = domain.stats();
-    const std::vector<double> work = domain.gather_work();
-    const auto gather = [&](double x) {
-      std::vector<double> all(static_cast<std::size_t>(g_size));
-      MPI_Allgather(&x, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD);
-      return all;
-    };
-    const std::vector<double> ghosts = gather(static_cast<double>(ds.ghosts));
-    const std::vector<double> comm = gather(ds.comm_seconds);
-    const auto list = [](const std::vector<double>& v, const char* fmt) {
-      std::string out = "[";
-      for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + fmt_double(fmt, v[k]);
-      return out + "]";
-    };
-    info.extra.emplace_back("rank_work", list(work, "%.0f"));
-    info.extra.emplace_back("rank_ghosts", list(ghosts, "%.0f"));
-    info.extra.emplace_back("rank_comm_seconds", list(comm, "%.4g"));
-    info.extra.emplace_back("imbalance", fmt_double("%.4g", ds.imbalance_work));
-    info.extra.emplace_back("imbalance_mean", fmt_double("%.4g", ds.imbalance_mean()));
-    info.extra.emplace_back("imbalance_equal_angle", fmt_double("%.4g", ds.imbalance_equal_angle));
-    info.extra.emplace_back("partitions", std::to_string(ds.partitions));
-    info.extra.emplace_back("partition_method", "\"" + ds.method + "\"");
-    info.extra.emplace_back("sectors", std::to_string(domain.partition().n_sectors));
+  // The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
+  // ghosts, migrations and time in communication; the imbalance against equal angles.
+  const DecompositionStats& ds = domain.stats();
+  const RankStats per_rank = domain.gather_rank_stats();
+  const auto list = [](const std::vector<double>& v, const char* fmt) {
+    std::string out = "[";
+    for (std::size_t k = 0; k < v.size(); ++k) out += (k ? ", " : "") + fmt_double(fmt, v[k]);
+    return out + "]";
+  };
+  info.extra.emplace_back("rank_work", list(per_rank.work, "%.0f"));
+  info.extra.emplace_back("rank_ghosts", list(per_rank.ghosts, "%.0f"));
+  info.extra.emplace_back("rank_comm_seconds", list(per_rank.comm_seconds, "%.4g"));
+  info.extra.emplace_back("imbalance", fmt_double("%.4g", ds.imbalance_work));
+  info.extra.emplace_back("imbalance_mean", fmt_double("%.4g", ds.imbalance_mean()));
+  info.extra.emplace_back("imbalance_equal_angle", fmt_double("%.4g", ds.imbalance_equal_angle));
+  info.extra.emplace_back("partitions", std::to_string(ds.partitions));
+  info.extra.emplace_back("partition_method", "\"" + ds.method + "\"");
+  info.extra.emplace_back("sectors", std::to_string(domain.partition().n_sectors));
+  return info;
+}
+
+int run(const Options& opt) {
+  Scene scene = load_deck(opt.deck, opt.sets);
+  if (!opt.output.empty()) scene.output.directory = opt.output;
+  if (opt.check) {
+    // Every rank evaluates the whole scene alike; rank 0 prints.
+    const Simulation whole(scene);
+    print_check(whole);
+    return kExitOk;
   }
+  MpiDomain domain(MPI_COMM_WORLD, decomposition_of(scene));
+  Simulation sim(scene, &domain);
+  const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
+  const OutputSpec& out = scene.output;
+  prepare_output(opt, scene);
+  SeriesOutput series(scene);
+  SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
+  if (!opt.quiet)
+    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(n_global) +
+        " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
+        (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory + "\n");
+
+  Progress progress(opt.quiet, scene.run.duration, out.progress_interval);
+  const auto start = Clock::now();
+  if (!advance(sim, scene, series, snapshots, progress, n_global)) return kExitUnstable;
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  const RunInfo info = run_info(sim, domain, scene, n_global, wall);
   if (g_rank == 0) write_run_json(out.directory + "/run.json", scene, info);
   if (!opt.quiet)
-    say(fmt_double("done: %.4g s simulated", sim.time()) + fmt_double(" in %.3g s of wall time", wall) +
+    say(fmt_double("done: %.4g s simulated", sim.time()) +
+        fmt_double(" in %.3g s of wall time", wall) +
         fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
   if (sim.unconverged_steps() > 0)
-    say("warning: the iterative integrator did not converge in " + std::to_string(sim.unconverged_steps()) +
+    say("warning: the iterative integrator did not converge in " +
+            std::to_string(sim.unconverged_steps()) +
             " steps (run.max_passes = " + std::to_string(scene.run.max_passes) + ")\n",
         stderr);
   return kExitOk;
@@ -297,7 +327,6 @@ int main(int argc, char** argv) {
   app.add_flag("--check", opt.check, "validate the deck, print derived quantities, run nothing");
   app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)");
   app.add_option("--output", opt.output, "output directory (overrides output.directory)");
-  app.add_option("--restart", opt.restart, "continue from a checkpoint file");
   app.add_flag("--quiet", opt.quiet, "no progress line");
   bool version = false;
   app.add_flag("--version", version, "print the version and exit");

@@ -5,6 +5,11 @@
 // one list: a new field is added in one place. Owned particles occupy [0, n_owned); ghosts
 // (copies of other ranks' particles, parallel runs only) follow in [n_owned, size()).
 //
+// A field also says what it means (FieldMeta: unit, a one-line description, whether snapshots
+// hold it). io/snapshots writes every field marked `snapshot` as a dataset of its name with
+// that unit and description, and a test checks docs/output.md's table of snapshot datasets
+// against the marked fields (tests/io/test_output.cpp).
+//
 // Conventions (physics.md section 1): a particle is a sphere whose centre moves in the
 // plane; mass m = 4/3 pi r^3 rho, moment of inertia I = 2/5 m r^2; angles and spins are
 // counter-clockwise positive.
@@ -22,14 +27,23 @@
 
 namespace dem2d {
 
+// What a field means, for output and documentation.
+struct FieldMeta {
+  std::string unit{};     // SI unit as written in snapshots ("m/s"); "1" for a pure number
+  std::string doc{};      // one line
+  bool snapshot = false;  // written to snapshots.h5 (state a user reads back)
+};
+
 class FieldBase {
  public:
-  explicit FieldBase(std::string name) : name_(std::move(name)) {}
+  explicit FieldBase(std::string name, FieldMeta meta = {})
+      : name_(std::move(name)), meta_(std::move(meta)) {}
   virtual ~FieldBase() = default;
   FieldBase(const FieldBase&) = delete;
   FieldBase& operator=(const FieldBase&) = delete;
 
   const std::string& name() const { return name_; }
+  const FieldMeta& meta() const { return meta_; }
   virtual std::size_t bytes_per_item() const = 0;
   virtual void resize(std::size_t n) = 0;
   virtual void copy_item(std::size_t dst, std::size_t src) = 0;
@@ -43,19 +57,25 @@ class FieldBase {
 
  private:
   std::string name_;
+  FieldMeta meta_;
 };
 
 template <class T>
 class Field final : public FieldBase {
  public:
-  Field(std::string name, std::vector<FieldBase*>& registry) : FieldBase(std::move(name)) {
+  Field(std::string name, std::vector<FieldBase*>& registry, FieldMeta meta = {})
+      : FieldBase(std::move(name), std::move(meta)) {
     registry.push_back(this);
   }
   std::size_t bytes_per_item() const override { return sizeof(T); }
   void resize(std::size_t n) override { data_.resize(n); }
   void copy_item(std::size_t dst, std::size_t src) override { data_[dst] = data_[src]; }
-  void pack(std::size_t i, std::byte* out) const override { std::memcpy(out, &data_[i], sizeof(T)); }
-  void unpack(std::size_t i, const std::byte* in) override { std::memcpy(&data_[i], in, sizeof(T)); }
+  void pack(std::size_t i, std::byte* out) const override {
+    std::memcpy(out, &data_[i], sizeof(T));
+  }
+  void unpack(std::size_t i, const std::byte* in) override {
+    std::memcpy(&data_[i], in, sizeof(T));
+  }
   std::byte* pack_items(std::span<const std::int32_t> idx, std::byte* out) const override {
     for (const std::int32_t i : idx) {
       std::memcpy(out, &data_[static_cast<std::size_t>(i)], sizeof(T));
@@ -94,23 +114,26 @@ class ParticleStore {
   ParticleStore& operator=(const ParticleStore&) = delete;
 
   // Identity and material.
-  Field<std::int64_t> id{"id", registry_};
-  Field<std::int32_t> material{"material", registry_};
+  Field<std::int64_t> id{
+      "id", registry_, {"1", "particle id, unique and stable for the whole run", true}};
+  Field<std::int32_t> material{"material", registry_, {"1", "row of /materials", true}};
   // Kinematics: position, velocity, acceleration (translational), angle, spin, angular acc.
-  Field<Vec2> pos{"position", registry_};
-  Field<Vec2> vel{"velocity", registry_};
-  Field<Vec2> acc{"acceleration", registry_};
-  Field<double> theta{"angle", registry_};
-  Field<double> omega{"spin", registry_};
-  Field<double> alpha{"angular_acceleration", registry_};
+  Field<Vec2> pos{"position", registry_, {"m", "x and y of the centre", true}};
+  Field<Vec2> vel{"velocity", registry_, {"m/s", "x and y of the centre's velocity", true}};
+  Field<Vec2> acc{"acceleration", registry_, {"m/s^2", "x and y of the acceleration"}};
+  Field<double> theta{
+      "angle", registry_, {"rad", "rotation since the start, counter-clockwise positive", true}};
+  Field<double> omega{
+      "spin", registry_, {"rad/s", "angular velocity, counter-clockwise positive", true}};
+  Field<double> alpha{"angular_acceleration", registry_, {"rad/s^2", "angular acceleration"}};
   // Shape and inertia (derived from radius and material density when a particle is added).
-  Field<double> radius{"radius", registry_};
-  Field<double> mass{"mass", registry_};
-  Field<double> inv_mass{"inv_mass", registry_};
-  Field<double> inv_inertia{"inv_inertia", registry_};
+  Field<double> radius{"radius", registry_, {"m", "radius", true}};
+  Field<double> mass{"mass", registry_, {"kg", "mass, 4/3 pi r^3 rho"}};
+  Field<double> inv_mass{"inv_mass", registry_, {"1/kg", "1 / mass"}};
+  Field<double> inv_inertia{"inv_inertia", registry_, {"1/(kg m^2)", "1 / (2/5 m r^2)"}};
   // Force and torque accumulators of the current force evaluation (not state).
-  Field<Vec2> force{"force", registry_};
-  Field<double> torque{"torque", registry_};
+  Field<Vec2> force{"force", registry_, {"N", "force of the current evaluation"}};
+  Field<double> torque{"torque", registry_, {"N m", "torque of the current evaluation"}};
 
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }

@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "core/errors.hpp"
+#include "parallel/comm.hpp"
 
 namespace dem2d::h5 {
 namespace {
@@ -40,21 +41,12 @@ std::string error_stack_detail() {
 
 RowRange row_range(MPI_Comm comm, std::size_t local_count) {
   const auto count = static_cast<std::uint64_t>(local_count);
-  std::uint64_t offset = 0;
-  std::uint64_t total = 0;
-  MPI_Exscan(&count, &offset, 1, MPI_UINT64_T, MPI_SUM, comm);
-  MPI_Allreduce(&count, &total, 1, MPI_UINT64_T, MPI_SUM, comm);
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  if (rank == 0) offset = 0;  // MPI_Exscan leaves rank 0's result undefined
-  return {offset, count, total};
+  return {mpi::exclusive_scan_sum(comm, count), count, mpi::sum(comm, count)};
 }
 
 RowRange rank0_rows(MPI_Comm comm, std::size_t count) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
   const auto n = static_cast<std::uint64_t>(count);
-  return {0, rank == 0 ? n : 0, n};
+  return {0, mpi::rank(comm) == 0 ? n : 0, n};
 }
 
 ParallelFile ParallelFile::create(MPI_Comm comm, const std::string& path) {
@@ -95,6 +87,16 @@ void ParallelFile::write_attribute(const std::string& object, const std::string&
 void ParallelFile::write_attribute(const std::string& object, const std::string& attribute,
                                    std::int64_t value) {
   write_scalar_attribute(object, attribute, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+}
+
+void ParallelFile::write_attribute(const std::string& object, const std::string& attribute,
+                                   const std::string& value) {
+  const std::string what = object + "@" + attribute;
+  DatatypeHandle type(check(H5Tcopy(H5T_C_S1), "create string type for", what));
+  check(H5Tset_size(type.get(), value.size() + 1), "set string size for", what);
+  check(H5Tset_strpad(type.get(), H5T_STR_NULLTERM), "set string padding for", what);
+  write_scalar_attribute(object, attribute, type.get(), type.get(), value.c_str());
+  check(type.close(), "close string type for", what);
 }
 
 void ParallelFile::write_scalar_attribute(const std::string& object, const std::string& attribute,

@@ -9,19 +9,21 @@
 // communicator, also on one rank. Every ParallelFile member is collective: all ranks of the
 // communicator call it, in the same order, with the same names and the same attribute
 // values. A row-distributed dataset has `total` rows of `columns` values; rank r writes its
-// `count` rows at row `offset`, where the offsets come from MPI_Exscan of the counts
-// (row_range), so rank 0's rows come first, then rank 1's, and so on. The data transfer is
-// collective (H5FD_MPIO_COLLECTIVE); a rank with no rows takes part with an empty selection.
+// `count` rows at row `offset`, where the offsets come from an exclusive scan of the counts
+// (row_range; the collectives are parallel/comm.hpp's), so rank 0's rows come first, then
+// rank 1's, and so on. The data transfer is collective (H5FD_MPIO_COLLECTIVE); a rank with no
+// rows takes part with an empty selection.
 #pragma once
 
 #include <hdf5.h>
-#include <mpi.h>
 
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "parallel/comm.hpp"  // MPI_Comm: the MPI-IO driver takes the communicator
 
 namespace dem2d::h5 {
 
@@ -63,9 +65,9 @@ using DatatypeHandle = Handle<H5Tclose>;
 
 // The rows one rank contributes to a row-distributed dataset.
 struct RowRange {
-  std::uint64_t offset = 0;  // first global row of this rank: MPI_Exscan of the counts
+  std::uint64_t offset = 0;  // first global row of this rank: exclusive scan of the counts
   std::uint64_t count = 0;   // rows this rank writes
-  std::uint64_t total = 0;   // rows of all ranks: MPI_Allreduce of the counts
+  std::uint64_t total = 0;   // rows of all ranks: sum of the counts
 };
 
 // Collective: the range of `local_count` rows on this rank, in rank order.
@@ -94,6 +96,9 @@ class ParallelFile {
   // Scalar attribute `attribute` on the object at `object` (an absolute path).
   void write_attribute(const std::string& object, const std::string& attribute, double value);
   void write_attribute(const std::string& object, const std::string& attribute, std::int64_t value);
+  // A fixed-length, null-terminated string (parallel HDF5 writes no variable-length data).
+  void write_attribute(const std::string& object, const std::string& attribute,
+                       const std::string& value);
 
   // Creates the dataset `name` (absolute path) with range.total rows of `columns` values
   // (rank 1 when columns == 1, else rank 2) and writes this rank's range.count rows from

@@ -9,7 +9,8 @@
 #include <filesystem>
 #include <system_error>
 
-#include "io/agree.hpp"
+#include "core/errors.hpp"
+#include "parallel/comm.hpp"
 
 namespace dem2d {
 namespace {
@@ -39,15 +40,13 @@ std::string check_directory(const fs::path& dir) {
 }  // namespace
 
 void prepare_output_directory(MPI_Comm comm, const std::string& dir) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
   std::string error;
-  if (rank == 0) {
+  if (mpi::rank(comm) == 0) {
     const std::string reason = check_directory(dir.empty() ? fs::path(".") : fs::path(dir));
     if (!reason.empty())
       error = fmt::format("cannot write to output directory '{}': {}", dir, reason);
   }
-  throw_if_any_rank_failed(comm, error);
+  mpi::agree_on_failure<IoError>(comm, error);
 }
 
 }  // namespace dem2d

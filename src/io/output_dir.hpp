@@ -2,9 +2,9 @@
 // all ranks together (style.md item 9).
 #pragma once
 
-#include <mpi.h>
-
 #include <string>
+
+#include "parallel/comm.hpp"
 
 namespace dem2d {
 

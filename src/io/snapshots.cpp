@@ -2,15 +2,17 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
 
 #include "core/errors.hpp"
-#include "io/agree.hpp"
 
 namespace dem2d {
 namespace {
@@ -22,10 +24,61 @@ static_assert(sizeof(Vec2) == 2 * sizeof(double) && std::is_standard_layout_v<Ve
 
 const double* as_doubles(const Field<Vec2>& f) { return reinterpret_cast<const double*>(f.data()); }
 
-bool is_standard_field(const std::string& name) {
-  for (const char* s : {"id", "position", "velocity", "spin", "radius", "material"})
-    if (name == s) return true;
-  return false;
+// The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
+constexpr const char* kGeometry = "position";
+
+// A registry field as the writer sees it: its values, element type and values per particle.
+struct Column {
+  enum Element { kInt64, kInt32, kDouble } element;
+  const void* data;
+  std::size_t columns;
+};
+
+// The column types snapshots can hold; std::nullopt for any other.
+std::optional<Column> column_of(const FieldBase& f) {
+  if (const auto* d = dynamic_cast<const Field<double>*>(&f))
+    return Column{Column::kDouble, d->data(), 1};
+  if (const auto* v = dynamic_cast<const Field<Vec2>*>(&f))
+    return Column{Column::kDouble, as_doubles(*v), 2};
+  if (const auto* i = dynamic_cast<const Field<std::int64_t>*>(&f))
+    return Column{Column::kInt64, i->data(), 1};
+  if (const auto* i = dynamic_cast<const Field<std::int32_t>*>(&f))
+    return Column{Column::kInt32, i->data(), 1};
+  return std::nullopt;
+}
+
+const char* type_name(Column::Element e) {
+  switch (e) {
+    case Column::kInt64:
+      return "int64";
+    case Column::kInt32:
+      return "int32";
+    case Column::kDouble:
+      break;
+  }
+  return "double";
+}
+
+// XDMF's NumberType and Precision of a SnapshotDataset::type.
+std::pair<const char*, int> xdmf_number(const std::string& type) {
+  if (type == "int64") return {"Int", 8};
+  if (type == "int32") return {"Int", 4};
+  return {"Float", 8};
+}
+
+void write_column(h5::ParallelFile& file, const std::string& name, const h5::RowRange& rows,
+                  const Column& c) {
+  switch (c.element) {
+    case Column::kInt64:
+      file.write_rows(name, rows, static_cast<const std::int64_t*>(c.data), c.columns);
+      return;
+    case Column::kInt32:
+      file.write_rows(name, rows, static_cast<const std::int32_t*>(c.data), c.columns);
+      return;
+    case Column::kDouble:
+      file.write_rows(name, rows, static_cast<const double*>(c.data), c.columns);
+      return;
+  }
 }
 
 // One XDMF DataItem that reads a whole dataset of snapshots.h5.
@@ -77,12 +130,25 @@ std::string write_file_atomically(const std::string& path, const std::string& te
 
 }  // namespace
 
+std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles) {
+  std::vector<SnapshotDataset> out;
+  for (const FieldBase* f : particles.fields()) {
+    if (!f->meta().snapshot) continue;
+    const std::optional<Column> c = column_of(*f);
+    if (!c)
+      throw std::logic_error("SnapshotWriter: field '" + f->name() +
+                             "' is marked for snapshots but its type cannot be written");
+    out.push_back({f->name(), type_name(c->element), c->columns, f->meta().unit, f->meta().doc});
+  }
+  return out;
+}
+
 SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
                                const std::vector<MaterialSpec>& materials)
     : comm_(comm),
       h5_path_((fs::path(directory) / "snapshots.h5").string()),
       xdmf_path_((fs::path(directory) / "snapshots.xmf").string()) {
-  MPI_Comm_rank(comm_, &rank_);
+  rank_ = mpi::rank(comm_);
   // Rank 0 tries the path first with plain stdio: the usual failures (no such directory, not
   // writable) give a clear reason, and all ranks learn of them before the collective create.
   std::string error;
@@ -96,7 +162,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
       fs::remove(xdmf_path_, ec);  // a stale sidecar would point at groups no longer there
     }
   }
-  throw_if_any_rank_failed(comm_, error);
+  mpi::agree_on_failure<IoError>(comm_, error);
   try {
     file_.emplace(h5::ParallelFile::create(comm_, h5_path_));
     write_materials(materials);
@@ -106,7 +172,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
   } catch (const IoError& e) {
     error = e.what();
   }
-  throw_if_any_rank_failed(comm_, error);
+  mpi::agree_on_failure<IoError>(comm_, error);
 }
 
 // Closes the file through the handle's destructor, which ignores (cannot report) a failure.
@@ -138,11 +204,13 @@ void SnapshotWriter::write_materials(const std::vector<MaterialSpec>& materials)
 void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
                            std::span<const ExtraField> extra) {
   if (!file_) throw std::logic_error("SnapshotWriter::write after close");
-  Record record{fmt::format("{:06d}", records_.size()), time, step, 0, {}};
+  Record record{fmt::format("{:06d}", records_.size()), time, step, 0, snapshot_datasets(p)};
   for (const ExtraField& e : extra) {
-    if (e.values.size() != p.n_owned() || is_standard_field(e.name) || e.name.empty())
+    const bool taken = std::any_of(record.datasets.begin(), record.datasets.end(),
+                                   [&](const SnapshotDataset& d) { return d.name == e.name; });
+    if (e.values.size() != p.n_owned() || taken || e.name.empty())
       throw std::invalid_argument("SnapshotWriter: bad extra field '" + e.name + "'");
-    record.extra.push_back(e.name);
+    record.datasets.push_back({e.name, "double", 1, e.unit, e.doc});
   }
   const std::string group = "/snapshots/" + record.name;
   std::string error;
@@ -152,14 +220,7 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
     file_->create_group(group);
     file_->write_attribute(group, "time", time);
     file_->write_attribute(group, "step", step);
-    file_->write_rows(group + "/id", rows, p.id.data());
-    file_->write_rows(group + "/position", rows, as_doubles(p.pos), 2);
-    file_->write_rows(group + "/velocity", rows, as_doubles(p.vel), 2);
-    file_->write_rows(group + "/spin", rows, p.omega.data());
-    file_->write_rows(group + "/radius", rows, p.radius.data());
-    file_->write_rows(group + "/material", rows, p.material.data());
-    for (const ExtraField& e : extra)
-      file_->write_rows(group + "/" + e.name, rows, e.values.data());
+    write_datasets(group, rows, p, extra);
     if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) {
       std::vector<std::int64_t> index(rows.count);
       for (std::uint64_t i = 0; i < rows.count; ++i)
@@ -171,10 +232,32 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   } catch (const IoError& e) {
     error = e.what();
   }
-  throw_if_any_rank_failed(comm_, error);
+  mpi::agree_on_failure<IoError>(comm_, error);
   records_.push_back(std::move(record));
   if (rank_ == 0) error = write_xdmf();
-  throw_if_any_rank_failed(comm_, error);
+  mpi::agree_on_failure<IoError>(comm_, error);
+}
+
+// The registry's snapshot fields in registry order, then the extra fields; each dataset with
+// its unit and description as attributes, so a file explains itself.
+void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange& rows,
+                                    const ParticleStore& p, std::span<const ExtraField> extra) {
+  const auto describe = [&](const std::string& name, const std::string& unit,
+                            const std::string& doc) {
+    file_->write_attribute(name, "unit", unit);
+    file_->write_attribute(name, "doc", doc);
+  };
+  for (const FieldBase* f : p.fields()) {
+    if (!f->meta().snapshot) continue;
+    const std::string name = group + "/" + f->name();
+    write_column(*file_, name, rows, *column_of(*f));  // snapshot_datasets checked the type
+    describe(name, f->meta().unit, f->meta().doc);
+  }
+  for (const ExtraField& e : extra) {
+    const std::string name = group + "/" + e.name;
+    file_->write_rows(name, rows, e.values.data());
+    describe(name, e.unit, e.doc);
+  }
 }
 
 void SnapshotWriter::close() {
@@ -186,7 +269,7 @@ void SnapshotWriter::close() {
     error = e.what();
   }
   file_.reset();
-  throw_if_any_rank_failed(comm_, error);
+  mpi::agree_on_failure<IoError>(comm_, error);
 }
 
 std::string SnapshotWriter::write_xdmf() const {
@@ -213,14 +296,13 @@ std::string SnapshotWriter::write_xdmf() const {
         "        <Geometry GeometryType=\"XY\">\n"
         "          {}\n"
         "        </Geometry>\n",
-        r.name, r.time, topology, hdf_item(h5, g + "/position", n, 2, "Float", 8));
-    text += point_attribute("velocity", h5, g + "/velocity", n, 2, "Float", 8);
-    text += point_attribute("spin", h5, g + "/spin", n, 1, "Float", 8);
-    text += point_attribute("radius", h5, g + "/radius", n, 1, "Float", 8);
-    text += point_attribute("material", h5, g + "/material", n, 1, "Int", 4);
-    text += point_attribute("id", h5, g + "/id", n, 1, "Int", 8);
-    for (const std::string& e : r.extra)
-      text += point_attribute(e, h5, g + "/" + e, n, 1, "Float", 8);
+        r.name, r.time, topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
+    for (const SnapshotDataset& d : r.datasets) {
+      if (d.name == kGeometry) continue;
+      const auto [number_type, precision] = xdmf_number(d.type);
+      text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
+                              number_type, precision);
+    }
     text += "      </Grid>\n";
   }
   text +=

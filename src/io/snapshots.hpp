@@ -7,22 +7,24 @@
 //               normal_stiffness}        one row per material, in deck order
 //   /snapshots/NNNNNN                    one group per write(), NNNNNN = 000000, 000001, ...
 //       attributes time (double, s), step (int64)
-//       id (int64, N), position (double, N x 2), velocity (double, N x 2), spin (double, N),
-//       radius (double, N), material (int32, N: row of /materials), and any extra fields
+//       one dataset per particle field marked `snapshot` in the store's registry
+//       (core/particles.hpp: id, material, position, velocity, angle, spin, radius), named as
+//       the field, N rows (N x 2 for a Vec2), with string attributes `unit` and `doc` from the
+//       field's FieldMeta; then any extra fields
 //   /xdmf/polyvertex_N                   int64 0..N-1, the connectivity snapshots.xmf uses for
 //                                        its Polyvertex topology (one per particle count N)
 // N is the global number of owned particles; rank 0's particles come first, then rank 1's...
 //
 // snapshots.xmf (XDMF 3): a temporal collection with one Polyvertex grid per snapshot, XY
-// geometry from position, attributes velocity (2-component Vector), spin, radius, material,
-// id and the extra fields. Checked with ParaView 5.11's "XDMF Reader" and "Xdmf3 Reader S/T".
+// geometry from position, and every other dataset as a point attribute (a Vec2 field, e.g.
+// velocity, as a 2-component Vector). Checked with ParaView 5.11's "XDMF Reader" and
+// "Xdmf3 Reader S/T".
 //
 // Every member is collective over the communicator. A failure throws IoError with the same
 // message on every rank.
 #pragma once
 
-#include <mpi.h>
-
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <set>
@@ -33,15 +35,32 @@
 #include "core/particles.hpp"
 #include "core/scene.hpp"
 #include "io/hdf5.hpp"
+#include "parallel/comm.hpp"
 
 namespace dem2d {
 
-// A per-model per-particle field written beside the standard ones (e.g. "damage" for ore):
-// one value per owned particle, in the store's order. Names must be the same on all ranks.
+// A per-particle field that is not in the store's registry, written after the registry's:
+// one value per owned particle, in the store's order. Names must be the same on all ranks and
+// differ from the registry's snapshot fields.
 struct ExtraField {
   std::string name;
   std::span<const double> values;
+  std::string unit = "1";
+  std::string doc{};
 };
+
+// One per-particle dataset of a snapshot group.
+struct SnapshotDataset {
+  std::string name;     // the field's name
+  std::string type;     // "int64", "int32" or "double" (little-endian in the file)
+  std::size_t columns;  // 1, or 2 for a Vec2 field (an N x 2 dataset)
+  std::string unit;     // the `unit` attribute
+  std::string doc;      // the `doc` attribute
+};
+
+// The datasets every snapshot of `particles` holds: the registry's fields marked `snapshot`,
+// in registry order. Throws std::logic_error for a marked field of a type it cannot write.
+std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles);
 
 class SnapshotWriter {
  public:
@@ -72,9 +91,11 @@ class SnapshotWriter {
     double time = 0.0;
     std::int64_t step = 0;
     std::uint64_t particles = 0;
-    std::vector<std::string> extra;
+    std::vector<SnapshotDataset> datasets;  // registry fields, then extra fields
   };
   void write_materials(const std::vector<MaterialSpec>& materials);
+  void write_datasets(const std::string& group, const h5::RowRange& rows, const ParticleStore& p,
+                      std::span<const ExtraField> extra);
   std::string write_xdmf() const;  // rank 0; returns an error message, empty on success
 
   MPI_Comm comm_;

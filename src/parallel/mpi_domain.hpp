@@ -12,11 +12,16 @@
 // halo width (2 r_max + skin) of it as a true distance (distance_to_wedge), which stays right
 // at the drum centre, where all wedges meet, and for wedges wider than pi.
 //
-// Plans and transport. A plan lists, per neighbour rank, the local indices to send and the
-// number to receive; the transport moves the bytes of any set of registered fields for a plan
-// (FieldBase::pack/unpack), so one plan serves every field: the halo plan is built at each
-// rebuild and reused by refresh_ghosts every force evaluation. Migration carries every
-// registered field and the contact histories of the particles that move.
+// Plans and transport. A plan lists, per peer rank, the local indices of the particles to
+// send and the number to receive (and, for a migration, the contact-history records that go
+// with them and the number of records to receive); the transport moves one message per peer
+// for a plan, point to point: the bytes of any set of registered fields (FieldBase::pack_items /
+// unpack_items, field by field), after an optional header, followed by the records. One plan
+// serves every field. Every plan is made the same way (make_plan: one all-to-all of the counts
+// tells each rank what it receives), and every byte between ranks goes through the one
+// transport: the halo plan is built at each rebuild and reused by refresh_ghosts and the
+// end-of-step round; a migration builds its own plan (the particles that left, with every
+// registered field and the contact histories that involve them) and sends it the same way.
 //
 // Checks. A particle that left its region by more than the halo width since the last
 // rebuild (it jumped past the ghosts of its new owner) is a hard error naming it; the global
@@ -36,11 +41,11 @@
 // and exchange_step() is the ghost refresh plus an MPI_Allreduce.
 //
 // Reductions are exact (max, logical or, integer sums) or order-fixed (double sums gathered and
-// added in rank order), so they give the same bits on every rank.
+// added in rank order), so they give the same bits on every rank. Every MPI call goes through
+// parallel/comm.hpp.
 #pragma once
 
-#include <mpi.h>
-
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -48,35 +53,45 @@
 
 #include "core/domain.hpp"
 #include "core/vec2.hpp"
+#include "parallel/comm.hpp"
 #include "parallel/sector_partition.hpp"
 
 namespace dem2d {
 
 struct DecompositionOptions {
-  Vec2 center{};                      // sectors are cut about this point (the drum centre)
-  bool has_center = false;            // false: the centre of the particles' bounding box
+  Vec2 center{};            // sectors are cut about this point (the drum centre)
+  bool has_center = false;  // false: the centre of the particles' bounding box
   // 32: bench/partition finds that contiguous arcs of 16 sectors per rank cannot balance a
   // settled charge within 5 % from 4 ranks up (granularity), 24 can, and from 32 METIS's
   // own grouping is mostly kept.
   int sectors_per_rank = 32;
-  double repartition_threshold = 1.05; // max/mean work that triggers a repartition
-  int repartition_gap = 10;           // rebuilds between two partitions at least
+  double repartition_threshold = 1.05;  // max/mean work that triggers a repartition
+  int repartition_gap = 10;             // rebuilds between two partitions at least
 };
 
 // What the decomposition did, for run.json and bench/strong_scaling.
 struct DecompositionStats {
-  int partitions = 0;                 // METIS partitions computed (1 = the initial one)
-  std::string method;                 // how the last partition was found
-  double imbalance_work = 1.0;        // max/mean of the last reported work
-  double imbalance_sum = 0.0;         // sum of imbalance_work over the rebuilds so far
-  std::int64_t reports = 0;           // rebuilds reported
-  double imbalance_mean() const { return reports ? imbalance_sum / static_cast<double>(reports) : 1.0; }
-  double imbalance_equal_angle = 1.0; // the same for equal-angle arcs at the last partition
-  double imbalance_partition = 1.0;   // predicted (sector weights) at the last partition
-  std::int64_t migrated = 0;          // particles sent by this rank, all rebuilds
-  std::int64_t ghosts = 0;            // ghosts on this rank after the last halo exchange
-  double comm_seconds = 0.0;          // wall time in migrate / exchange_halo / refresh_ghosts
-  double work = 0.0;                  // this rank's last reported work
+  int partitions = 0;           // METIS partitions computed (1 = the initial one)
+  std::string method;           // how the last partition was found
+  double imbalance_work = 1.0;  // max/mean of the last reported work
+  double imbalance_sum = 0.0;   // sum of imbalance_work over the rebuilds so far
+  std::int64_t reports = 0;     // rebuilds reported
+  double imbalance_mean() const {
+    return reports ? imbalance_sum / static_cast<double>(reports) : 1.0;
+  }
+  double imbalance_equal_angle = 1.0;  // the same for equal-angle arcs at the last partition
+  double imbalance_partition = 1.0;    // predicted (sector weights) at the last partition
+  std::int64_t migrated = 0;           // particles sent by this rank, all rebuilds
+  std::int64_t ghosts = 0;             // ghosts on this rank after the last halo exchange
+  double comm_seconds = 0.0;           // wall time in migrate / exchange_halo / refresh_ghosts
+  double work = 0.0;                   // this rank's last reported work
+};
+
+// Per-rank figures of the decomposition, in rank order (run.json).
+struct RankStats {
+  std::vector<double> work;          // DecompositionStats::work of each rank
+  std::vector<double> ghosts;        // DecompositionStats::ghosts
+  std::vector<double> comm_seconds;  // DecompositionStats::comm_seconds
 };
 
 class MpiDomain final : public Domain {
@@ -109,29 +124,51 @@ class MpiDomain final : public Domain {
   const DecompositionStats& stats() const { return stats_; }
   // The rank each ghost slot came from (ghost g is store index n_owned() + g).
   std::vector<int> ghost_origin() const;
-  // Every rank's stats.work, gathered (collective).
-  std::vector<double> gather_work() const;
+  // Every rank's work, ghosts and communication time, gathered (collective).
+  RankStats gather_rank_stats() const;
 
  private:
-  // Who sends what to whom: per peer rank, local indices to send and the count to receive.
+  // Who sends what to whom: per peer rank, local indices to send and the count to receive;
+  // for a migration also the history records (indices into the HistoryRecords) that travel
+  // with the particles and the count of records to receive (both empty for the halo).
   struct Plan {
-    std::vector<int> peers;                  // ranks exchanged with, ascending
-    std::vector<std::vector<std::int32_t>> send;  // per peer: local indices
-    std::vector<std::size_t> recv_count;     // per peer
+    std::vector<int> peers;                              // ranks exchanged with, ascending
+    std::vector<std::vector<std::int32_t>> send;         // per peer: local particle indices
+    std::vector<std::size_t> recv_count;                 // per peer: particles
+    std::vector<std::vector<std::size_t>> send_records;  // per peer: history records
+    std::vector<std::size_t> recv_records;               // per peer: history records
+  };
+  // The bytes of one message: `header`, then `per_particle` for each particle, then
+  // `per_record` for each history record.
+  struct MessageLayout {
+    std::size_t header = 0;
+    std::size_t per_particle = 0;
+    std::size_t per_record = 0;
   };
   void repartition(const ParticleStore& p);
   void rebuild_wedges();
+  // The plan that sends to[q] (local indices) and records_to[q] (history records; an empty
+  // `records_to`: none) to each rank q. One all-to-all of the counts tells each rank what it
+  // receives. Peers: every other rank when `all_peers`, else the ranks with traffic either way.
+  Plan make_plan(std::vector<std::vector<std::int32_t>> to,
+                 std::vector<std::vector<std::size_t>> records_to, bool all_peers) const;
   // Ghosts' `recv_fields` from their owners' `send_fields`; `values`, when not empty, travel
   // ahead of the ghosts in every message and are maximised (all ranks must be peers).
   void fill_ghosts(ParticleStore& p, std::span<FieldBase* const> send_fields,
                    std::span<FieldBase* const> recv_fields, std::span<double> values = {});
-  // Point-to-point exchange of one plan's bytes: `header_bytes` then `bytes_per_item` per
-  // listed index.
-  void transport(const Plan& plan, std::size_t header_bytes, std::size_t bytes_per_item,
+  // Migration, in order: the new owner of each owned particle (a jump past the halo is an
+  // error agreed on by every rank), the plan, its messages, and the arrivals appended.
+  std::vector<int> new_owners(const ParticleStore& p, bool repartitioned) const;
+  Plan migration_plan(const ParticleStore& p, const HistoryRecords& histories,
+                      const std::vector<int>& owner) const;
+  void pack_migration(const ParticleStore& p, const HistoryRecords& histories, const Plan& plan);
+  void unpack_migration(ParticleStore& p, HistoryRecords& histories, const Plan& plan) const;
+  // The one point-to-point exchange of a plan's messages: send[u] to plan.peers[u], recv[u]
+  // (sized here from the plan and `layout`) from it. Used by the halo, the end-of-step round
+  // and migration alike.
+  void transport(const Plan& plan, const MessageLayout& layout,
                  const std::vector<std::vector<std::byte>>& send,
                  std::vector<std::vector<std::byte>>& recv);
-  // Collective: throws std::runtime_error with the first failing rank's message on every rank.
-  void agree(const std::string& local_error) const;
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -143,7 +180,8 @@ class MpiDomain final : public Domain {
   std::int64_t total_particles_ = 0;
   Plan halo_;
   std::vector<std::int32_t> halo_sources_;  // union of halo_.send, ascending
-  bool all_peers_ = false;                   // every other rank is in halo_.peers
+  bool all_peers_ = false;                  // every other rank is in halo_.peers
+  // Message buffers, kept between calls: the halo refresh runs every step.
   std::vector<std::vector<std::byte>> send_buffers_, recv_buffers_;
   std::vector<MPI_Request> requests_;
   std::vector<double> reduce_buffer_;  // exchange_step without all peers: values and NaN flags

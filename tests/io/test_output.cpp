@@ -15,6 +15,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -119,7 +120,7 @@ struct Expected {
   std::int64_t id;
   std::int32_t material;
   Vec2 pos, vel;
-  double spin, radius;
+  double spin, radius, angle;
 };
 
 Expected expected(int k, int version) {
@@ -129,7 +130,8 @@ Expected expected(int k, int version) {
           {0.1 * k + 1.0 / 3.0 + v, -0.2 * k - v / 7.0},
           {1.5 * k - v, -k / 7.0 + 0.01 * v},
           0.3 * k - 1.0 + v / 3.0,
-          0.01 * (k + 1)};
+          0.01 * (k + 1),
+          -0.7 * k + v / 9.0};
 }
 
 double damage(int k) { return k / 11.0; }
@@ -145,7 +147,8 @@ std::vector<double> fill(ParticleStore& store, int n, int version, Owner owner) 
   for (int k = 0; k < n; ++k) {
     if (owner(k) != comm_rank()) continue;
     const Expected e = expected(k, version);
-    store.add(e.id, e.material, e.radius, 7800.0, e.pos, e.vel, e.spin);
+    const std::size_t i = store.add(e.id, e.material, e.radius, 7800.0, e.pos, e.vel, e.spin);
+    store.theta[i] = e.angle;
     dmg.push_back(damage(k));
   }
   const std::size_t g = store.add_ghosts(2);
@@ -216,6 +219,34 @@ std::vector<std::string> read_strings(hid_t file, const std::string& name) {
   return out;
 }
 
+// A fixed-length string attribute (what ParallelFile::write_attribute writes for a string).
+std::string read_string_attribute(hid_t file, const std::string& object, const std::string& name) {
+  H5Closer a{H5Aopen_by_name(file, object.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+             H5Aclose};
+  EXPECT_GE(a.id, 0) << object << "@" << name;
+  if (a.id < 0) return {};
+  H5Closer t{H5Aget_type(a.id), H5Tclose};
+  EXPECT_EQ(H5Tget_class(t.id), H5T_STRING) << object << "@" << name;
+  EXPECT_EQ(H5Tis_variable_str(t.id), 0);
+  const std::size_t width = H5Tget_size(t.id);
+  std::vector<char> buffer(width + 1, '\0');
+  EXPECT_GE(H5Aread(a.id, t.id, buffer.data()), 0);
+  return std::string(buffer.data(), strnlen(buffer.data(), width));
+}
+
+// The names of the members of group `name`.
+std::set<std::string> group_members(hid_t file, const std::string& name) {
+  std::set<std::string> out;
+  H5Literate_by_name(
+      file, name.c_str(), H5_INDEX_NAME, H5_ITER_INC, nullptr,
+      [](hid_t, const char* member, const H5L_info_t*, void* data) -> herr_t {
+        static_cast<std::set<std::string>*>(data)->insert(member);
+        return 0;
+      },
+      &out, H5P_DEFAULT);
+  return out;
+}
+
 using Dims = std::vector<hsize_t>;
 
 // Checks /snapshots/NAME against particles [0, n) of `version`, all values exactly.
@@ -239,7 +270,10 @@ void check_snapshot(hid_t file, const std::string& name, int n, int version, dou
   EXPECT_EQ(dims, (Dims{un}));
   const auto material = read_dataset<std::int32_t>(file, g + "/material", H5T_NATIVE_INT32, dims);
   EXPECT_EQ(dims, (Dims{un}));
+  const auto angle = read_dataset<double>(file, g + "/angle", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un}));
   ASSERT_EQ(id.size(), un);
+  ASSERT_EQ(angle.size(), un);
   ASSERT_EQ(pos.size(), 2 * un);
   ASSERT_EQ(vel.size(), 2 * un);
   ASSERT_EQ(spin.size(), un);
@@ -256,6 +290,7 @@ void check_snapshot(hid_t file, const std::string& name, int n, int version, dou
     EXPECT_EQ(vel[2 * i + 1], e.vel.y) << "k=" << k;
     EXPECT_EQ(spin[i], e.spin) << "k=" << k;
     EXPECT_EQ(radius[i], e.radius) << "k=" << k;
+    EXPECT_EQ(angle[i], e.angle) << "k=" << k;
   }
 }
 
@@ -378,8 +413,10 @@ TEST(SnapshotWriter, TwoSnapshotsRoundTripExactly) {
     const std::string path = xmf.substr(i, xmf.find('<', i) - i);
     EXPECT_GT(H5Lexists(file.id, path.c_str(), H5P_DEFAULT), 0) << path;
   }
-  // Per snapshot: topology, position, velocity, spin, radius, material, id; then damage.
-  EXPECT_EQ(references, 2u * 7u + 1u);
+  // Per snapshot: the topology and every dataset (position as the geometry); then damage.
+  const std::size_t datasets = snapshot_datasets(ParticleStore{}).size();
+  EXPECT_EQ(references, 2u * (1u + datasets) + 1u);
+  EXPECT_EQ(count(xmf, "<Attribute Name=\"angle\" AttributeType=\"Scalar\""), 2u);
   EXPECT_EQ(count(xmf, "<Attribute Name=\"velocity\" AttributeType=\"Vector\""), 2u);
   EXPECT_EQ(count(xmf, "Name=\"damage\""), 1u);
   // The Polyvertex connectivity, shared by both snapshots of 5 particles.
@@ -447,6 +484,83 @@ TEST(SnapshotWriter, StaleSidecarIsRemoved) {
   if (comm_rank() == 0) {
     EXPECT_FALSE(fs::exists(dir / "snapshots.xmf"));
   }
+}
+
+// The field registry decides what a snapshot holds: every field marked `snapshot` (and no
+// other) is a dataset of its name, type and shape, with its unit and description attached.
+TEST(SnapshotWriter, EveryRegistryFieldMarkedForOutputIsWrittenWithItsUnit) {
+  ScratchDir dir;
+  const int n = 6;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    ParticleStore p;
+    fill(p, n, 3, [&](int k) { return block_owner(k, n); });
+    writer.write(p, 0.5, 50);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  const ParticleStore registry;
+  std::set<std::string> marked;
+  for (const FieldBase* f : registry.fields()) {
+    if (!f->meta().snapshot) continue;
+    marked.insert(f->name());
+    SCOPED_TRACE("field " + f->name());
+    EXPECT_FALSE(f->meta().unit.empty());
+    EXPECT_FALSE(f->meta().doc.empty());
+    const std::string path = "/snapshots/000000/" + f->name();
+    ASSERT_GT(H5Lexists(file.id, path.c_str(), H5P_DEFAULT), 0);
+    EXPECT_EQ(read_string_attribute(file.id, path, "unit"), f->meta().unit);
+    EXPECT_EQ(read_string_attribute(file.id, path, "doc"), f->meta().doc);
+    H5Closer d{H5Dopen2(file.id, path.c_str(), H5P_DEFAULT), H5Dclose};
+    H5Closer space{H5Dget_space(d.id), H5Sclose};
+    Dims dims(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space.id)));
+    H5Sget_simple_extent_dims(space.id, dims.data(), nullptr);
+    EXPECT_EQ(dims[0], static_cast<hsize_t>(n));
+    EXPECT_EQ(H5Dget_storage_size(d.id) / static_cast<hsize_t>(n), f->bytes_per_item())
+        << "one item of the field per row";
+  }
+  EXPECT_TRUE(marked.contains("angle")) << "the rotation angle is state a user reads back";
+  EXPECT_FALSE(marked.contains("force")) << "accumulators are not state";
+  EXPECT_EQ(group_members(file.id, "/snapshots/000000"), marked) << "nothing else is written";
+  // snapshot_datasets() describes the same datasets, in registry order.
+  std::set<std::string> described;
+  for (const SnapshotDataset& d : snapshot_datasets(registry)) described.insert(d.name);
+  EXPECT_EQ(described, marked);
+}
+
+// docs/output.md's table of snapshot datasets is the registry's, row for row (run the test
+// to see the rows to paste when a field changes).
+TEST(SnapshotWriter, OutputDocsListExactlyTheRegistryDatasets) {
+  if (comm_rank() != 0) return;
+  const std::string docs = read_text(std::string(DEM2D_SOURCE_DIR) + "/docs/output.md");
+  const std::size_t begin = docs.find("\n## snapshots.h5\n");
+  ASSERT_NE(begin, std::string::npos);
+  const std::size_t end = docs.find("\n## ", begin + 1);
+  std::set<std::string> documented;
+  std::istringstream section(docs.substr(begin, end - begin));
+  for (std::string line; std::getline(section, line);)
+    if (line.starts_with("| `")) documented.insert(line);
+  std::set<std::string> expected_rows;
+  std::string table;
+  for (const SnapshotDataset& d : snapshot_datasets(ParticleStore{})) {
+    const std::string shape = d.columns == 1 ? "(N)" : "(N, " + std::to_string(d.columns) + ")";
+    const std::string row =
+        "| `" + d.name + "` | " + d.type + " | " + shape + " | " + d.unit + " | " + d.doc + " |";
+    expected_rows.insert(row);
+    table += row + "\n";
+  }
+  EXPECT_EQ(documented, expected_rows) << "the rows docs/output.md should have:\n" << table;
+}
+
+TEST(SnapshotWriter, ExtraFieldMayNotReuseARegistryName) {
+  ScratchDir dir;
+  SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+  ParticleStore p;
+  const std::vector<double> values = fill(p, 3, 0, [](int) { return 0; });
+  const ExtraField clash[] = {{"angle", values}};
+  EXPECT_THROW(writer.write(p, 0.0, 0, clash), std::invalid_argument);
 }
 
 void expect_same_io_error_everywhere(const std::function<void()>& f, const std::string& prefix) {
