@@ -81,6 +81,59 @@ std::int64_t fill_count(const Scene& scene, std::size_t f) {
   return k;
 }
 
+namespace {
+
+// A free site of a fill's lattice and its sort key (the order the region fills it in).
+struct Site {
+  Vec2 x;
+  double key;
+};
+
+// The sites of fill f: a triangular lattice of spacing 2.1 radius_max over the region, minus
+// the sites that touch a wall or a particle already placed, each with its key (random for
+// `full` and `box`, by row for `bottom`, by distance from the shell for `annulus`).
+std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const ParticleStore& store,
+                             std::size_t f, double r_all_max) {
+  const FillSpec& s = scene.fills[f];
+  const bool needs_drum = s.region != FillRegion::kBox;
+  const double spacing = 2.1 * s.radius_max;
+  const double row = spacing * std::sqrt(3.0) / 2.0;
+  Vec2 lo = s.box_min, hi = s.box_max;
+  const Vec2 c = scene.drum.center;
+  double r_in = 0.0;
+  if (needs_drum) {
+    r_in = scene.drum.sides == 0
+               ? scene.drum.radius
+               : scene.drum.radius * std::cos(std::numbers::pi / scene.drum.sides);
+    lo = c - Vec2{r_in, r_in};
+    hi = c + Vec2{r_in, r_in};
+  }
+  PlacedGrid placed(store, 2.0 * r_all_max);
+  const double half = 0.5 * spacing;
+  std::vector<Site> sites;
+  long row_index = 0;
+  for (double y = lo.y + half; y <= hi.y - half + 1e-12; y += row, ++row_index) {
+    const double x0 = lo.x + half + ((row_index % 2) ? half : 0.0);
+    for (double x = x0; x <= hi.x - half + 1e-12; x += spacing) {
+      const Vec2 p{x, y};
+      if (needs_drum && norm(p - c) > r_in - half) continue;
+      bool clear = true;
+      for (int e = 0; e < static_cast<int>(walls.elements().size()) && clear; ++e)
+        if (walls.geometry(e, p, half).delta > 0.0) clear = false;
+      if (!clear || placed.overlaps(p, half, r_all_max)) continue;
+      const std::uint64_t id = sites.size();
+      const double u = random_uniform(scene.run.seed, kFillStream + 1000 + f, id);
+      double key = u;  // full, box: random order
+      if (s.region == FillRegion::kBottom) key = static_cast<double>(row_index) + u;
+      if (s.region == FillRegion::kAnnulus) key = -norm(p - c) + 1e-3 * u * spacing;
+      sites.push_back({p, key});
+    }
+  }
+  return sites;
+}
+
+}  // namespace
+
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store) {
   std::vector<std::string> errors;
   std::int64_t next_id = static_cast<std::int64_t>(store.size());
@@ -96,50 +149,13 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
 
   for (std::size_t f = 0; f < scene.fills.size(); ++f) {
     const FillSpec& s = scene.fills[f];
-    const bool needs_drum = s.region != FillRegion::kBox;
-    if (needs_drum && !scene.drum.present) {
+    if (s.region != FillRegion::kBox && !scene.drum.present) {
       errors.push_back(where(scene, s) +
                        "region needs a [drum]; use region = \"box\" with box_min and box_max");
       continue;
     }
     const std::int64_t n = fill_count(scene, f);
-    const double spacing = 2.1 * s.radius_max;
-    const double row = spacing * std::sqrt(3.0) / 2.0;
-    Vec2 lo = s.box_min, hi = s.box_max;
-    const Vec2 c = scene.drum.center;
-    double r_in = 0.0;
-    if (needs_drum) {
-      r_in = scene.drum.sides == 0
-                 ? scene.drum.radius
-                 : scene.drum.radius * std::cos(std::numbers::pi / scene.drum.sides);
-      lo = c - Vec2{r_in, r_in};
-      hi = c + Vec2{r_in, r_in};
-    }
-    PlacedGrid placed(store, 2.0 * r_all_max);
-    const double half = 0.5 * spacing;
-    struct Site {
-      Vec2 x;
-      double key;
-    };
-    std::vector<Site> sites;
-    long row_index = 0;
-    for (double y = lo.y + half; y <= hi.y - half + 1e-12; y += row, ++row_index) {
-      const double x0 = lo.x + half + ((row_index % 2) ? half : 0.0);
-      for (double x = x0; x <= hi.x - half + 1e-12; x += spacing) {
-        const Vec2 p{x, y};
-        if (needs_drum && norm(p - c) > r_in - half) continue;
-        bool clear = true;
-        for (int e = 0; e < static_cast<int>(walls.elements().size()) && clear; ++e)
-          if (walls.geometry(e, p, half).delta > 0.0) clear = false;
-        if (!clear || placed.overlaps(p, half, r_all_max)) continue;
-        const std::uint64_t id = sites.size();
-        const double u = random_uniform(scene.run.seed, kFillStream + 1000 + f, id);
-        double key = u;  // full, box: random order
-        if (s.region == FillRegion::kBottom) key = static_cast<double>(row_index) + u;
-        if (s.region == FillRegion::kAnnulus) key = -norm(p - c) + 1e-3 * u * spacing;
-        sites.push_back({p, key});
-      }
-    }
+    std::vector<Site> sites = fill_sites(scene, walls, store, f, r_all_max);
     if (static_cast<std::int64_t>(sites.size()) < n) {
       errors.push_back(where(scene, s) + std::to_string(n) +
                        " particles do not fit: the region holds " + std::to_string(sites.size()) +
@@ -150,6 +166,8 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
     std::stable_sort(sites.begin(), sites.end(),
                      [](const Site& a, const Site& b) { return a.key < b.key; });
     const int mat = find_material(scene, s.material);
+    const double spacing = 2.1 * s.radius_max;  // as in fill_sites
+    const double half = 0.5 * spacing;
     for (std::int64_t k = 0; k < n; ++k) {
       const double r = fill_radius(scene, f, k);
       // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
