@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Compare two dem2d snapshots.h5 files snapshot by snapshot, particles matched by id.
 
-    post/h5compare.py A/snapshots.h5 B/snapshots.h5 [--atol 0] [--show 10]
+    post/h5compare.py A/snapshots.h5 B/snapshots.h5 [--atol 0] [--show 10] [--allow-added]
 
 Within each snapshot both files' particles are sorted by id, so runs on different rank counts
 (whose files hold the particles in a different order) compare equal when the physics is the
@@ -23,8 +23,10 @@ import numpy as np
 
 
 class Report:
-    def __init__(self, show):
+    def __init__(self, show, allow_added=False):
         self.show = show
+        self.allow_added = allow_added  # datasets only in the second file are not differences
+        self.added = set()
         self.shown = 0
         self.differences = 0
         self.max_abs = {}  # field -> largest |a - b|
@@ -101,6 +103,9 @@ def compare_snapshot(name, ga, gb, atol, report):
                       f"{only_a[:5].tolist()}, {len(only_b)} only in the second {only_b[:5].tolist()}")
     fields = sorted(set(ga.keys()) | set(gb.keys()))
     for field in fields:
+        if field not in ga and report.allow_added:
+            report.added.add(field)
+            continue
         if field not in ga or field not in gb:
             report.differ(f"{where}/{field}: only in the {'first' if field in ga else 'second'} file")
             continue
@@ -137,6 +142,9 @@ def main(argv=None):
     parser.add_argument("--atol", type=float, default=0.0,
                         help="accept floating-point differences up to this (default 0: bit-identical)")
     parser.add_argument("--show", type=int, default=10, help="differences to print (default 10)")
+    parser.add_argument("--allow-added", action="store_true",
+                        help="per-particle datasets only in the second file (a newer dem2d that writes "
+                             "more) are listed, not counted as differences; every common one must match")
     args = parser.parse_args(argv)
     try:
         fa = h5py.File(args.first, "r")
@@ -144,7 +152,7 @@ def main(argv=None):
     except OSError as e:
         print(f"h5compare.py: {e}", file=sys.stderr)
         return 2
-    report = Report(args.show)
+    report = Report(args.show, args.allow_added)
     with fa, fb:
         compare_materials(fa, fb, args.atol, report)
         sa = sorted(fa["snapshots"].keys()) if "snapshots" in fa else []
@@ -158,7 +166,8 @@ def main(argv=None):
             compare_snapshot(name, fa["snapshots"][name], fb["snapshots"][name], args.atol, report)
     if report.differences == 0:
         what = "bit-identical" if args.atol == 0 else f"identical within atol = {args.atol:g}"
-        print(f"{len(common)} snapshots {what}")
+        added = f"; datasets only in the second file: {', '.join(sorted(report.added))}" if report.added else ""
+        print(f"{len(common)} snapshots {what}{added}")
         return 0
     if report.differences > report.shown:
         print(f"... {report.differences - report.shown} more differences")
