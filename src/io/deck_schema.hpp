@@ -310,7 +310,7 @@ inline constexpr Key<RunSpec> kRunKeys[] = {
      .range = kNonNegative,
      .max = INT64_MAX,
      .field = member<&RunSpec::seed>(),
-     .doc = "every random draw (fill placement, breakage) derives from it; the same seed gives "
+     .doc = "every random draw (fill placement) derives from it; the same seed gives "
             "the same run on any rank count"},
     {.name = "gravity",
      .type = Type::kVector,
