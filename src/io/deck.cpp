@@ -46,6 +46,18 @@ using deck::Value;
 // ---------------------------------------------------------------------------------------------
 // Text helpers
 
+// The whole of an open file into `text`; closes it. Returns 0, or the errno of a read error
+// (EIO when the stream failed without one).
+int read_and_close(std::FILE* stream, std::string& text) {
+  char buffer[65536];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, stream)) > 0;)
+    text.append(buffer, n);
+  const bool failed = std::ferror(stream) != 0;
+  const int read_errno = errno;
+  std::fclose(stream);
+  return failed ? (read_errno != 0 ? read_errno : EIO) : 0;
+}
+
 // A node as it would be written in TOML, for messages (shortest round-trip numbers).
 std::string value_text(const toml::node& node) {
   if (const auto* s = node.as_string()) return quoted_string(s->get());
@@ -956,13 +968,7 @@ class DeckParser {
       return;
     }
     std::string text;
-    char buffer[65536];
-    for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, stream)) > 0;)
-      text.append(buffer, n);
-    const bool failed = std::ferror(stream) != 0;
-    const int read_errno = errno;
-    std::fclose(stream);
-    if (failed) {
+    if (const int read_errno = read_and_close(stream, text); read_errno != 0) {
       r.invalid("file", fmt::format("cannot read {}: {}", shown, std::strerror(read_errno)));
       return;
     }
@@ -1048,13 +1054,7 @@ Scene load_deck(const std::string& path, const std::vector<std::string>& overrid
     throw InputError(fmt::format("{}: error: cannot open deck: {}", path, std::strerror(errno)));
   }
   std::string text;
-  char buffer[65536];
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, stream)) > 0;)
-    text.append(buffer, n);
-  const bool failed = std::ferror(stream) != 0;
-  const int read_errno = errno;
-  std::fclose(stream);
-  if (failed) {
+  if (const int read_errno = read_and_close(stream, text); read_errno != 0) {
     throw InputError(
         fmt::format("{}: error: cannot read deck: {}", path, std::strerror(read_errno)));
   }
