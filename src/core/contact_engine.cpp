@@ -418,10 +418,17 @@ std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
 }  // namespace
 
 // The model is chosen here, once: one kernel per (law, rolling model, tracker).
+// A rolling model is run only when some pair of materials has rolling friction: with mu_r = 0
+// everywhere it gives no torque and stores nothing (measured bit-identical to none), and the
+// epsd kernel cost 6 % more on such a scene.
 std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec,
                                                    const PairTable& table) {
+  bool rolling_friction = false;
+  for (int a = 0; a < table.n_materials(); ++a)
+    for (int b = 0; b < table.n_materials(); ++b) rolling_friction |= table(a, b).mu_r != 0.0;
+  const RollingModelKind rolling_kind = rolling_friction ? spec.rolling : RollingModelKind::kNone;
   return pick<ContactLaws>(spec.model, [&](auto law) {
-    return pick<RollingModels>(spec.rolling, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
+    return pick<RollingModels>(rolling_kind, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
       using Law = typename decltype(law)::type;
       using Rolling = typename decltype(rolling)::type;
       if (spec.track_peak_energy)

@@ -945,5 +945,31 @@ TEST(ModelSlots, TheTrackerChangesNoParticleState) {
   }
 }
 
+// A rolling model that no pair of materials uses is not run: without rolling friction the
+// epsd deck runs the kernel without rolling, and the run is the one with rolling = "none".
+TEST(ModelSlots, ARollingModelNoPairUsesIsNotRun) {
+  const auto scene = [](RollingModelKind rolling) {
+    Scene s = head_on_scene(false);
+    s.contact.rolling = rolling;
+    s.materials = {steel(0.5, 0.3, 0.0)};
+    s.particles = {ball("steel", 0.05, {-0.0501, 0.0}, {1.0, 0.3}, 20.0),
+                   ball("steel", 0.05, {0.0501, 0.01}, {-1.0, 0.0}, -5.0)};
+    return s;
+  };
+  Simulation epsd(scene(RollingModelKind::kEpsd)), none(scene(RollingModelKind::kNone));
+  EXPECT_EQ(slot_names(epsd), std::vector<std::string>{"xi"}) << "no rolling spring is carried";
+  epsd.run_until(6.0e-4);
+  none.run_until(6.0e-4);
+  ASSERT_GT(epsd.particles().omega[0], 0.0);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(epsd.particles().pos[k], none.particles().pos[k]);
+    EXPECT_EQ(epsd.particles().vel[k], none.particles().vel[k]);
+    EXPECT_EQ(epsd.particles().omega[k], none.particles().omega[k]);
+  }
+  Scene rolling = scene(RollingModelKind::kEpsd);
+  rolling.materials = {steel(0.5, 0.3, 0.05)};
+  EXPECT_EQ(slot_names(Simulation(rolling)), (std::vector<std::string>{"xi", "m_roll"}));
+}
+
 }  // namespace
 }  // namespace dem2d
