@@ -62,7 +62,10 @@ struct ContactForceT {
   T f_n = T(0.0);         // N, >= 0 (never attractive)
   T f_t = T(0.0);         // N, on i along t
   T k_n = T(0.0);         // N/m, normal tangent stiffness (feeds the epsd rolling spring)
-  T k_rate = T(0.0);      // 1/s, d(ln k_n)/dt: Hertz stiffness ~ sqrt(delta) -> v_n / (2 delta)
+  // k_n(delta_old) / k_n(delta) with delta_old = delta - v_n dt, the overlap at the start of the
+  // step: how much the stiffness of the springs that follow k_n (tangential, rolling) changed
+  // over the step (Hertz: sqrt(delta_old / delta), 0 at first touch; constant stiffness: 1).
+  T k_prev_ratio = T(1.0);
   T dissipated = T(0.0);  // J in this step
   T elastic = T(0.0);     // J stored (normal + tangential springs)
   T strain = T(0.0);      // J, the normal elastic energy the breakage law reads (physics.md 5)
@@ -105,6 +108,13 @@ inline Coeffs<Pack> broadcast_coeffs(const Coeffs<double>& c) {
 
 inline double sign(double x) { return vsign(x); }
 
+// k(delta_old) / k(delta) for a stiffness ~ sqrt(delta) (Hertz), delta_old = delta - v_n dt the
+// overlap at the start of the step (0 if the contact began within it).
+template <class T>
+[[gnu::always_inline]] inline T hertz_stiffness_ratio(const KinematicsT<T>& k, double dt) {
+  return vsqrt(vmax(T(0.0), k.delta - k.v_n * dt) / k.delta);
+}
+
 // Tangential spring-dashpot with a Coulomb cap (hertz-mindlin and linear):
 //   xi += v_t dt, F_t = -k_t xi - c_t v_t, |F_t| <= mu_s F_n; when capped, xi shrinks so the
 //   spring alone equals the cap.
@@ -113,13 +123,17 @@ inline double sign(double x) { return vsign(x); }
 // both cases would count a spurious k_t dxi^2 / 2 each step: an O(dt) drift in the balance.)
 // A spring whose stiffness follows the overlap (Hertz: k ~ sqrt(delta)) is not derived from a
 // potential: holding xi while delta changes changes 1/2 k xi^2 with no force doing work. That
-// change, 1/2 k xi^2 d(ln k)/dt dt, is booked as dissipated (it may be negative) so that the
-// energy balance closes; `k_rate` is d(ln k)/dt (0 for a constant stiffness).
+// change, 1/2 xi^2 (k_old - k_new), is booked as dissipated (it may be negative) so that the
+// energy balance closes; `k_prev_ratio` is k_old / k_new (1 for a constant stiffness). It is
+// the finite change over the step, not the derivative d(ln k)/dt dt = v_n dt / (2 delta): at
+// the end of a contact the overlap is of the order of v_n dt, the derivative is no longer
+// small, and booking it overstated the dissipation by up to 40 % of an impact's true loss
+// whatever the dt (oblique steel impact, e = 0.05, mu = 0.3).
 template <class T, class M>
-[[gnu::always_inline]] inline void tangential_spring(T k_t, T k_rate, T c_t, M mu_s, T f_n, T v_t,
+[[gnu::always_inline]] inline void tangential_spring(T k_t, T k_prev_ratio, T c_t, M mu_s, T f_n, T v_t,
                                                      double dt, T xi_old, T& xi_new,
                                                      ContactForceT<T>& out) {
-  out.dissipated = out.dissipated - 0.5 * k_t * xi_old * xi_old * k_rate * dt;
+  out.dissipated = out.dissipated + 0.5 * k_t * xi_old * xi_old * (k_prev_ratio - 1.0);
   const T xi = xi_old + v_t * dt;
   const T f_t = -k_t * xi - c_t * v_t;
   const T cap = mu_s * f_n;
@@ -190,9 +204,9 @@ struct HertzMindlin : TangentialSpringHistory {
     out.dissipated = (f_n - f_el) * k.v_n * dt;
     out.elastic = 0.4 * f_el * k.delta;  // 8/15 E* sqrt(R*) delta^2.5
     out.strain = out.elastic;
-    out.k_rate = 0.5 * k.v_n / k.delta;  // d ln sqrt(delta) / dt, with d(delta)/dt = v_n
+    out.k_prev_ratio = hertz_stiffness_ratio(k, dt);
     const T s_t = 8.0 * c.g_star * s;
-    tangential_spring(s_t, out.k_rate, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t,
+    tangential_spring(s_t, out.k_prev_ratio, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t,
                       dt, old[0], h[0], out);
     return out;
   }
@@ -232,7 +246,7 @@ struct ThesisModel : NoHistory {
     out.f_n = f_n;
     out.f_t = f_t;
     out.k_n = s_n;
-    out.k_rate = 0.5 * k.v_n / k.delta;
+    out.k_prev_ratio = hertz_stiffness_ratio(k, dt);
     out.dissipated = (f_n - f_el) * k.v_n * dt - f_t * k.v_t * dt;
     out.elastic = 0.4 * f_el * k.delta;
     out.strain = 0.5 * f_el * k.delta;
@@ -370,7 +384,9 @@ struct RollingEpsd {
     const T m_old = old[0];
     const T m_k = m_old - k_r * k.omega_rel * dt;
     const T half_compliance = 0.5 / k_r;
-    const T stiffness_change = half_compliance * m_old * m_old * cf.k_rate * dt;
+    // M^2 / 2 (1 / k_old - 1 / k_new); a new contact (k_old = 0) has no rolling torque yet.
+    const T stiffness_change = select(cf.k_prev_ratio > 0.0,
+                                      half_compliance * m_old * m_old * (1.0 / cf.k_prev_ratio - 1.0), T(0.0));
     const T stored_old = m_old * m_old;
     // Full mobilisation: plastic rolling at the cap, no dashpot.
     const auto full = vabs(m_k) >= m_max;
