@@ -103,9 +103,10 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
   const double* tq = p.torque.data();
   const double* inv_m = p.inv_mass.data();
   const double* inv_i = p.inv_inertia.data();
+  const double* r = p.radius.data();
   const Vec2 g = gravity_;
-  double checksum = 0.0, disp2 = 0.0, speed2 = 0.0;
-#pragma omp simd reduction(+ : checksum) reduction(max : disp2, speed2)
+  double checksum = 0.0, disp2 = 0.0, speed2 = 0.0, motion2 = 0.0;
+#pragma omp simd reduction(+ : checksum) reduction(max : disp2, speed2, motion2)
   for (std::size_t k = 0; k < n; ++k) {
     accelerate(a[k], al[k], f[k], tq[k], inv_m[k], inv_i[k], g);
     checksum += (a[k].x + a[k].y) + al[k] + (x[k].x + x[k].y);
@@ -113,10 +114,12 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
     w[k] += h * al[k];
     const double d2 = norm2(x[k] - x_build[k]);
     const double s2 = norm2(v[k] + h * a[k]);
+    const double m2 = s2 / (r[k] * r[k]);
     disp2 = disp2 > d2 ? disp2 : d2;
     speed2 = speed2 > s2 ? speed2 : s2;
+    motion2 = motion2 > m2 ? motion2 : m2;
   }
-  return {checksum, disp2, speed2};
+  return {checksum, disp2, speed2, motion2};
 }
 
 // The step's one collective: stability, and whether the next step rebuilds. The next drift
@@ -126,7 +129,9 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
 // drift them to next, and the next step skips the refresh (wasted when it rebuilds, one step in
 // a hundred or more).
 StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
-  const bool local_ok = std::isfinite(c.checksum) && s.totals().max_overlap <= kMaxOverlapRatio;
+  const double motion = dt_ * std::sqrt(c.motion2);
+  const bool local_ok = std::isfinite(c.checksum) && s.totals().max_overlap <= kMaxOverlapRatio &&
+                        motion <= kMaxStepMotion;
   double reduce[2] = {local_ok ? 0.0 : 1.0, std::sqrt(c.disp2) + dt_ * std::sqrt(c.speed2)};
   Domain& domain = s.domain();
   if (domain.size() > 1) {
@@ -138,7 +143,14 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
   }
   if (!std::isfinite(reduce[1])) reduce[0] = 1.0;
   rebuild_next_ = s.rebuilds().due(reduce[1], s.walls(), s.time(), dt_);
-  return {reduce[0] != 0.0, c.checksum};
+  StepOutcome out{reduce[0] != 0.0, c.checksum, motion};
+  if (out.unstable && motion > kMaxStepMotion) {  // name the particle (rare: only now)
+    const ParticleStore& p = s.particles();
+    for (std::size_t k = 0; k < p.n_owned() && out.motion_id < 0; ++k)
+      if (dt_ * norm(p.vel[k] + (0.5 * dt_) * p.acc[k]) / p.radius[k] > kMaxStepMotion)
+        out.motion_id = p.id[k];
+  }
+  return out;
 }
 
 void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p,
@@ -182,8 +194,26 @@ StepOutcome IterativeIntegrator::step(StepStages& s) {
   if (!converged) ++passes_.unconverged_steps;
   s.commit(dt_);
   passes_.add(pass);
-  const bool local_ok = std::isfinite(checksum) && s.totals().max_overlap <= kMaxOverlapRatio;
-  return {s.domain().any(!local_ok), checksum};
+  // The state returned is checked, not only the last pass: a step whose passes did not settle
+  // may end far from where its forces were evaluated (bodies through each other).
+  StepOutcome out;
+  out.checksum = checksum;
+  largest_motion(p, out);
+  const bool local_ok = std::isfinite(checksum) && s.totals().max_overlap <= kMaxOverlapRatio &&
+                        out.motion <= kMaxStepMotion;
+  out.unstable = s.domain().any(!local_ok);
+  return out;
+}
+
+// The largest |x1 - x0| / r of the step just taken (a NaN position gives NaN: not <= the bound).
+void IterativeIntegrator::largest_motion(const ParticleStore& p, StepOutcome& out) const {
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    const double m = norm(p.pos[k] - x0_[k]) / p.radius[k];
+    if (!(m <= out.motion)) {
+      out.motion = m;
+      out.motion_id = p.id[k];
+    }
+  }
 }
 
 // The neighbour lists must hold through every pass of this step, and a rebuild (which may

@@ -76,9 +76,18 @@ class StepStages {
 
 // The end-of-step round's verdict (the same on every rank) and this rank's checksum of the
 // accelerations (and, Verlet, positions): non-finite when something blew up here.
+// A particle may move at most this many of its radii in one step. Beyond it a contact could
+// begin at an overlap past kMaxOverlapRatio, or two bodies pass through each other unseen; the
+// safe dt keeps a particle's move per step some hundred times smaller.
+inline constexpr double kMaxStepMotion = 0.25;
+
 struct StepOutcome {
   bool unstable = false;
   double checksum = 0.0;
+  // This rank's largest move per step in radii (Verlet: the coming drift, dt |v + a dt/2| / r;
+  // iterative: the step just taken, |x1 - x0| / r) and the id of the particle making it.
+  double motion = 0.0;
+  std::int64_t motion_id = -1;
 };
 
 // Passes of force evaluation per step (always 1 for Verlet).
@@ -150,6 +159,7 @@ class VelocityVerlet final : public Integrator {
   struct Closing {
     double checksum = 0.0;
     double disp2 = 0.0, speed2 = 0.0;  // max |x - x_build|^2 and |v + a dt/2|^2 (owned)
+    double motion2 = 0.0;              // max |v + a dt/2|^2 / r^2 (owned)
   };
   void kick_drift_owned(ParticleStore& p) const;
   Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
@@ -183,6 +193,7 @@ class IterativeIntegrator final : public Integrator {
   void save_start(const ParticleStore& p);
   void predict(ParticleStore& p) const;
   bool settled(const ParticleStore& p, Domain& domain);
+  void largest_motion(const ParticleStore& p, StepOutcome& out) const;
 
   double dt_;
   Vec2 gravity_;

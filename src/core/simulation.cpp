@@ -151,6 +151,12 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
         continue;
       o << (named++ ? ", particle " : " of particle ") << p.id[k];
     }
+  } else if (const double motion = domain_->max(outcome.motion); motion > kMaxStepMotion) {
+    const bool mine = outcome.motion == motion;
+    const auto id = static_cast<std::int64_t>(
+        domain_->max(mine ? static_cast<double>(outcome.motion_id) : -2.0));
+    o << "particle " << id << " moves " << motion << " times its radius in one step (at most "
+      << kMaxStepMotion << "): bodies could pass through each other";
   } else {
     // The pair at the largest overlap, named alike on every rank (ids are below 2^53).
     const bool mine = totals.max_overlap == max_overlap;

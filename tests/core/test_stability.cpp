@@ -337,6 +337,37 @@ TEST(Stability, BlowUpThrowsUnstableErrorNamingParticles) {
   EXPECT_TRUE(all_finite(sim.particles()));
 }
 
+// Bodies never pass through each other with a clean exit: at a dt that lets two steel balls
+// (r = 0.05 m, 2 x 100 m/s head-on) move a whole radius per step, both integrators stop at the
+// first step, naming a particle that moves too far (kMaxStepMotion); the iterative scheme
+// checks the state it returns, not only its last pass.
+TEST(Stability, BodiesCannotPassThroughEachOtherUnseen) {
+  for (const IntegratorKind integrator : {IntegratorKind::kVerlet, IntegratorKind::kIterative}) {
+    Scene s = base_scene(integrator);
+    s.run.gravity = {0.0, 0.0};
+    add_ball(s, {-0.2, 0.0}, {100.0, 0.0}, 0.05);
+    add_ball(s, {0.2, 0.0}, {-100.0, 0.0}, 0.05);
+    s.run.dt_auto = false;
+    s.run.dt = 5.0e-4;  // 100 m/s x 5e-4 s = 0.05 m: one radius per step
+    s.run.allow_unsafe_dt = true;
+    Simulation sim(s);
+    std::string what;
+    std::int64_t step = -1;
+    try {
+      for (int k = 0; k < 20; ++k) sim.step();
+    } catch (const UnstableError& e) {
+      what = e.what();
+      step = e.step();
+    }
+    std::cout << "[ motion ] " << integrator_name(integrator) << ": " << what << "\n";
+    EXPECT_EQ(step, 1) << integrator_name(integrator) << ": stopped before the balls could meet";
+    EXPECT_NE(what.find("moves 1 times its radius in one step"), std::string::npos) << what;
+    EXPECT_TRUE(what.find("particle 0") != std::string::npos ||
+                what.find("particle 1") != std::string::npos)
+        << what;
+  }
+}
+
 // Non-finite blow-up: two balls given the same centre (their contact normal is 0/0) among
 // others in a drum. interface.md (exit 3): "non-finite values, or an overlap beyond a safe
 // fraction of a radius: report step, time, particle ids, and the dt that would be safe". The
