@@ -46,6 +46,21 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
   builds_at_backup_ = contacts_.builds();
 }
 
+// The energy balance as the first step starts (after whatever the caller set by hand), and
+// the energy scale below which a balance error does not count: each particle lifted by its
+// radius, sum m |g| r (a resting pile's chatter is not a blow-up).
+void Simulation::take_energy_baseline() {
+  const SeriesRow r = diagnostics();
+  motion0_ = r.kinetic_energy + r.rotational_energy + r.elastic_energy;
+  potential0_ = r.potential_energy;
+  balance0_ = motion0_ + potential0_ + r.dissipated_energy - r.drive_work;
+  double floor = 0.0;
+  for (std::size_t k = 0; k < particles_.n_owned(); ++k)
+    floor += particles_.mass[k] * norm(scene_.run.gravity) * particles_.radius[k];
+  energy_floor_ = domain_->sum(floor);
+  baseline_taken_ = true;
+}
+
 void Simulation::choose_dt() {
   if (scene_.run.dt_auto || scene_.run.dt <= 0.0) {
     dt_ = scales_.safe_dt;
@@ -67,9 +82,11 @@ void Simulation::choose_dt() {
 // steps on every rank, and after every rebuild so that it holds the particles this rank owns
 // now (a rebuild may migrate them).
 void Simulation::step() {
+  if (!baseline_taken_) take_energy_baseline();
   const StepOutcome outcome = integrator_->step(*this);
   ++step_;
   if (outcome.unstable) report_unstable(outcome);
+  if (step_ % kEnergyCheckSteps == 0 || time_ + 0.5 * dt_ >= scene_.run.duration) check_energy();
   if (step_ % 1000 == 0 || builds_at_backup_ != contacts_.builds()) {
     backup_.save(particles_, time_, step_);
     builds_at_backup_ = contacts_.builds();
@@ -178,6 +195,24 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
     o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
   }
   throw UnstableError(o.str(), failed_step, failed_time);
+}
+
+// The balance kinetic + rotational + potential + elastic + dissipated - drive work is constant
+// up to the integrator's error. Grown beyond the tolerance, the run created energy.
+void Simulation::check_energy() const {
+  const SeriesRow r = diagnostics();
+  const double created = r.kinetic_energy + r.rotational_energy + r.potential_energy +
+                         r.elastic_energy + r.dissipated_energy - r.drive_work - balance0_;
+  const double through = energy_floor_ + motion0_ + std::abs(r.drive_work) +
+                         std::abs(r.dissipated_energy) + std::abs(r.potential_energy - potential0_);
+  if (!(created > kEnergyCreatedTolerance * through)) return;
+  std::ostringstream o;
+  o << "the run became unstable at step " << step_ << " (t = " << time_
+    << " s): energy was created: " << created << " J since the start, " << created / through
+    << " of the " << through << " J that went through the system (at most "
+    << kEnergyCreatedTolerance << "); dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt
+    << " s";
+  throw UnstableError(o.str(), step_, time_);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -368,6 +368,42 @@ TEST(Stability, BodiesCannotPassThroughEachOtherUnseen) {
   }
 }
 
+// A run that creates energy does not end with exit 0: a Verlet head-on impact (steel, e = 0.73,
+// 2 x 5 m/s) at 8 x the safe dt leaves at restitution 0.96; the balance check (every
+// kEnergyCheckSteps steps and at the deck's last step) stops it naming the step. At the safe dt
+// the same impact passes, with its balance error under the tolerance.
+TEST(Stability, EnergyCreatedIsAnError) {
+  Scene s = base_scene(IntegratorKind::kVerlet);
+  s.materials[0] = thesis_steel(0.73);
+  s.run.gravity = {0.0, 0.0};
+  s.run.duration = 0.01;
+  add_ball(s, {-0.11, 0.0}, {5.0, 0.0}, 0.1);
+  add_ball(s, {0.11, 0.0}, {-5.0, 0.0}, 0.1);
+  const double safe = Simulation(s).dt();
+  for (const double factor : {1.0, 8.0}) {
+    s.run.dt_auto = false;
+    s.run.dt = factor * safe;
+    s.run.allow_unsafe_dt = true;
+    Simulation sim(s);
+    std::string what;
+    try {
+      while (sim.time() + 0.5 * sim.dt() < s.run.duration) sim.step();
+    } catch (const UnstableError& e) {
+      what = e.what();
+    }
+    std::cout << "[ energy guard ] " << factor << " x safe dt: "
+              << (what.empty()
+                      ? "no error, restitution " +
+                            str((sim.particles().vel[1].x - sim.particles().vel[0].x) / 10.0)
+                      : what)
+              << "\n";
+    if (factor == 1.0)
+      EXPECT_TRUE(what.empty()) << what;
+    else
+      EXPECT_NE(what.find("energy was created"), std::string::npos) << "exit 3, not 0: " << what;
+  }
+}
+
 // Non-finite blow-up: two balls given the same centre (their contact normal is 0/0) among
 // others in a drum. interface.md (exit 3): "non-finite values, or an overlap beyond a safe
 // fraction of a radius: report step, time, particle ids, and the dt that would be safe". The
