@@ -20,9 +20,11 @@ double steps_per_contact_for(double restitution) {
 TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   TimeScales ts;
   const double g = norm(scene.run.gravity);
-  // Largest expected impact speed: the drum's rim speed twice (a ball thrown off the shell
-  // meets the shell coming the other way) plus free fall across the drum; without a drum,
-  // the fastest initial particle plus free fall across the particles' extent.
+  // Largest expected closing speeds. Against a wall: the drum's rim speed twice (a ball thrown
+  // off the shell meets the shell coming the other way) plus free fall across the drum; without
+  // a drum, the fastest initial particle plus the walls' speeds plus free fall across the
+  // particles' extent. Between two particles: two of the fastest head-on (with a drum, a ball
+  // riding the shell at rim speed meets one thrown at rim speed), plus free fall.
   double v_max = 0.0, y_lo = std::numeric_limits<double>::max(), y_hi = -y_lo;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     v_max = std::max(v_max, norm(p.vel[k]) + std::abs(p.omega[k]) * p.radius[k]);
@@ -30,6 +32,7 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
     y_hi = std::max(y_hi, p.pos[k].y + p.radius[k]);
   }
   double fall = p.n_owned() > 0 ? y_hi - y_lo : 0.0;
+  double v_part = v_max;
   for (const WallSpec& w : scene.walls) {
     fall = std::max(fall, y_hi - std::min(w.from.y, w.to.y));
     v_max += norm(w.velocity);
@@ -37,31 +40,42 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   if (scene.drum.present) {
     fall = 2.0 * scene.drum.radius;
     v_max = std::max(v_max, 2.0 * std::abs(scene.drum.speed) * scene.drum.radius);
+    v_part = std::max(v_part, std::abs(scene.drum.speed) * scene.drum.radius);
   }
-  ts.impact_speed = std::max(v_max + std::sqrt(2.0 * g * std::max(fall, 0.0)), 1e-3);
+  const double free_fall = std::sqrt(2.0 * g * std::max(fall, 0.0));
+  const double v_wall = std::max(v_max + free_fall, 1e-3);
+  const double v_pair = std::max(2.0 * v_part + free_fall, 1e-3);
+  ts.impact_speed = std::max(v_wall, v_pair);
 
   ts.rayleigh = std::numeric_limits<double>::max();
   ts.hertz = std::numeric_limits<double>::max();
   const PairTable table(scene);
-  // Per material: the smallest radius and mass present.
+  // Per material: the smallest radius present (the shortest contact time: t_c ~ r).
   const std::size_t nm = scene.materials.size();
   std::vector<double> r_min(nm, std::numeric_limits<double>::max());
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     r_min[p.material[k]] = std::min(r_min[p.material[k]], p.radius[k]);
+  // Hertz contact time t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5) (Johnson 1985).
+  const auto contact_time = [](double m_eff, double r_eff, double e_star, double v) {
+    return 2.868 * std::pow(m_eff * m_eff / (r_eff * e_star * e_star * v), 0.2);
+  };
   for (std::size_t a = 0; a < nm; ++a) {
     if (r_min[a] == std::numeric_limits<double>::max()) continue;
     const MaterialSpec& m = scene.materials[a];
     ts.rayleigh =
         std::min(ts.rayleigh, std::numbers::pi * r_min[a] * std::sqrt(m.density / m.shear_modulus) /
                                   (0.1631 * m.poisson_ratio + 0.8766));
-    // Hertz contact time of the smallest sphere against a wall of the stiffest material
-    // (m* = m, R* = r): t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5).
+    const double mass_a = ParticleStore::sphere_mass(r_min[a], m.density);
     for (std::size_t b = 0; b < nm; ++b) {
-      const double mass = ParticleStore::sphere_mass(r_min[a], m.density);
       const double e_star = table(static_cast<int>(a), static_cast<int>(b)).e_star;
-      const double tc =
-          2.868 * std::pow(mass * mass / (r_min[a] * e_star * e_star * ts.impact_speed), 0.2);
-      ts.hertz = std::min(ts.hertz, tc);
+      // The smallest sphere against a wall of material b (m* = m, R* = r).
+      ts.hertz = std::min(ts.hertz, contact_time(mass_a, r_min[a], e_star, v_wall));
+      // Against the smallest sphere of material b: the pair's reduced mass and radius.
+      if (r_min[b] == std::numeric_limits<double>::max()) continue;
+      const double mass_b = ParticleStore::sphere_mass(r_min[b], scene.materials[b].density);
+      ts.hertz = std::min(
+          ts.hertz, contact_time(mass_a * mass_b / (mass_a + mass_b),
+                                 r_min[a] * r_min[b] / (r_min[a] + r_min[b]), e_star, v_pair));
     }
   }
   if (ts.rayleigh == std::numeric_limits<double>::max()) ts.rayleigh = ts.hertz = 1.0;

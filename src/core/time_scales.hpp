@@ -10,8 +10,8 @@ namespace dem2d {
 // Derived time scales of a scene (interface.md --check).
 struct TimeScales {
   double rayleigh = 0.0;         // s, smallest Rayleigh time pi r sqrt(rho/G)/(0.1631 nu + 0.8766)
-  double hertz = 0.0;            // s, smallest Hertz contact time at the impact speed below
-  double impact_speed = 0.0;     // m/s, largest expected impact speed
+  double hertz = 0.0;            // s, smallest Hertz contact time: particle pairs and walls
+  double impact_speed = 0.0;     // m/s, largest expected closing speed (pairs or walls)
   double restitution_min = 1.0;  // smallest restitution of the material pairs present
   double steps_per_contact = 0.0;  // Hertz contact resolved with this many steps (see below)
   double safe_dt = 0.0;            // s, what dt = "auto" picks

@@ -97,6 +97,31 @@ HeadOn head_on(double e, IntegratorKind integrator) {
   return out;
 }
 
+// dt = "auto" resolves the shortest contact the scene can have with the intended number of
+// steps: here a head-on pair of equal balls (reduced mass m/2, radius r/2, closing at twice the
+// fastest ball's speed), not one ball against a wall at its own speed, which gave a contact
+// time 32 % too long (15 steps instead of 20).
+TEST(Stability, AutoDtResolvesAHeadOnPairWithTheIntendedSteps) {
+  for (const double e : {1.0, 0.73}) {  // damping lengthens a contact: e = 0.3 takes 164 of 133
+    Scene s = base_scene(IntegratorKind::kVerlet);
+    s.materials[0] = thesis_steel(e);
+    s.run.gravity = {0.0, 0.0};
+    add_ball(s, {-0.11, 0.0}, {20.0, 0.0}, 0.1);
+    add_ball(s, {0.11, 0.0}, {-20.0, 0.0}, 0.1);
+    Simulation sim(s);
+    int steps_in_contact = 0;
+    while (sim.time() < 2e-3) {
+      sim.step();
+      steps_in_contact += sim.last_totals().contacts > 0 ? 1 : 0;
+    }
+    const double intended = steps_per_contact_for(sim.scales().restitution_min);
+    std::cout << "[ auto dt ] head-on pair, e " << e << ": " << steps_in_contact
+              << " steps in contact, intended " << intended << "\n";
+    EXPECT_GE(steps_in_contact, intended - 1.0) << "e = " << e;
+    EXPECT_LE(steps_in_contact, 1.2 * intended + 1.0) << "e = " << e << ": not needlessly small";
+  }
+}
+
 // Thesis restitution (zeta_n = 0.1 -> e = 0.73) and e = 1: obtained within 1 %, and the largest
 // overlap of the elastic impact equals Hertz's (validation.md section 1):
 // delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) with v = 40 m/s.

@@ -466,7 +466,8 @@ TEST(Reproducibility, IterativeIntegratorCentrifuging) {
   Scene s = thesis_drum(120, 10.0, 8);
   s.title = "centrifuging charge, iterative integrator";
   s.run.integrator = IntegratorKind::kIterative;
-  expect_same_as_serial(s, 8000, 1000);
+  // 0.17 s at the auto dt: long enough for balls to cross sector boundaries.
+  expect_same_as_serial(s, 10000, 1000);
 }
 
 }  // namespace
