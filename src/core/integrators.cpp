@@ -194,11 +194,16 @@ StepOutcome IterativeIntegrator::step(StepStages& s) {
   if (!converged) ++passes_.unconverged_steps;
   s.commit(dt_);
   passes_.add(pass);
-  // The state returned is checked, not only the last pass: a step whose passes did not settle
-  // may end far from where its forces were evaluated (bodies through each other).
+  return end_of_step_round(s, checksum);
+}
+
+// The step's verdict on every rank. The state returned is checked, not only the last pass: a
+// step whose passes did not settle may end far from where its forces were evaluated (bodies
+// through each other).
+StepOutcome IterativeIntegrator::end_of_step_round(StepStages& s, double checksum) const {
   StepOutcome out;
   out.checksum = checksum;
-  largest_motion(p, out);
+  largest_motion(s.particles(), out);
   const bool local_ok = std::isfinite(checksum) && s.totals().max_overlap <= kMaxOverlapRatio &&
                         out.motion <= kMaxStepMotion;
   out.unstable = s.domain().any(!local_ok);

@@ -194,6 +194,7 @@ class IterativeIntegrator final : public Integrator {
   void predict(ParticleStore& p) const;
   bool settled(const ParticleStore& p, Domain& domain);
   void largest_motion(const ParticleStore& p, StepOutcome& out) const;
+  StepOutcome end_of_step_round(StepStages& s, double checksum) const;
 
   double dt_;
   Vec2 gravity_;
