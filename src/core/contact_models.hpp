@@ -59,9 +59,9 @@ using HistoryArray = std::array<T, N>;
 
 template <class T>
 struct ContactForceT {
-  T f_n = T(0.0);         // N, >= 0 (never attractive)
-  T f_t = T(0.0);         // N, on i along t
-  T k_n = T(0.0);         // N/m, normal tangent stiffness (feeds the epsd rolling spring)
+  T f_n = T(0.0);  // N, >= 0 (never attractive)
+  T f_t = T(0.0);  // N, on i along t
+  T k_n = T(0.0);  // N/m, normal tangent stiffness (feeds the epsd rolling spring)
   // k_n(delta_old) / k_n(delta) with delta_old = delta - v_n dt, the overlap at the start of the
   // step: how much the stiffness of the springs that follow k_n (tangential, rolling) changed
   // over the step (Hertz: sqrt(delta_old / delta), 0 at first touch; constant stiffness: 1).
@@ -130,8 +130,8 @@ template <class T>
 // small, and booking it overstated the dissipation by up to 40 % of an impact's true loss
 // whatever the dt (oblique steel impact, e = 0.05, mu = 0.3).
 template <class T, class M>
-[[gnu::always_inline]] inline void tangential_spring(T k_t, T k_prev_ratio, T c_t, M mu_s, T f_n, T v_t,
-                                                     double dt, T xi_old, T& xi_new,
+[[gnu::always_inline]] inline void tangential_spring(T k_t, T k_prev_ratio, T c_t, M mu_s, T f_n,
+                                                     T v_t, double dt, T xi_old, T& xi_new,
                                                      ContactForceT<T>& out) {
   out.dissipated = out.dissipated + 0.5 * k_t * xi_old * xi_old * (k_prev_ratio - 1.0);
   const T xi = xi_old + v_t * dt;
@@ -206,8 +206,8 @@ struct HertzMindlin : TangentialSpringHistory {
     out.strain = out.elastic;
     out.k_prev_ratio = hertz_stiffness_ratio(k, dt);
     const T s_t = 8.0 * c.g_star * s;
-    tangential_spring(s_t, out.k_prev_ratio, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n, k.v_t,
-                      dt, old[0], h[0], out);
+    tangential_spring(s_t, out.k_prev_ratio, T(c.damp * c.tangential_ratio * root), c.mu_s, f_n,
+                      k.v_t, dt, old[0], h[0], out);
     return out;
   }
 };
@@ -385,8 +385,9 @@ struct RollingEpsd {
     const T m_k = m_old - k_r * k.omega_rel * dt;
     const T half_compliance = 0.5 / k_r;
     // M^2 / 2 (1 / k_old - 1 / k_new); a new contact (k_old = 0) has no rolling torque yet.
-    const T stiffness_change = select(cf.k_prev_ratio > 0.0,
-                                      half_compliance * m_old * m_old * (1.0 / cf.k_prev_ratio - 1.0), T(0.0));
+    const T stiffness_change =
+        select(cf.k_prev_ratio > 0.0,
+               half_compliance * m_old * m_old * (1.0 / cf.k_prev_ratio - 1.0), T(0.0));
     const T stored_old = m_old * m_old;
     // Full mobilisation: plastic rolling at the cap, no dashpot.
     const auto full = vabs(m_k) >= m_max;

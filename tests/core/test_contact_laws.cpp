@@ -975,9 +975,9 @@ TEST(ModelSlots, ARollingModelNoPairUsesIsNotRun) {
 // ---------------------------------------------------------------------------------------------
 // The energy ledger of one oblique impact with friction and rolling resistance (issue: honest
 // numbers). Two steel spheres (r = 0.1 m) meet at 2 x (5, 3) m/s, offset so that they slide,
-// e = 0.05, mu_s = 0.3, without and with epsd rolling (mu_r = 0.05). The dissipated energy booked by the laws must
-// equal the mechanical energy lost, converging at first order in dt (the dashpots see the
-// half-step velocity), for every phase of the first touch within a step. Booked as the
+// e = 0.05, mu_s = 0.3, without and with epsd rolling (mu_r = 0.05). The dissipated energy booked
+// by the laws must equal the mechanical energy lost, converging at first order in dt (the dashpots
+// see the half-step velocity), for every phase of the first touch within a step. Booked as the
 // derivative v_n dt / (2 delta) of the stiffness (before), the ledger overstated the loss by
 // 15 % to 4.4 times here, with no convergence in dt.
 double ledger_error(double dt, double phase, double mu_r) {
