@@ -14,8 +14,6 @@
 
 #include <array>
 #include <cstdint>
-#include <initializer_list>
-#include <vector>
 
 #include "core/array.hpp"
 

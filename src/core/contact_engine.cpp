@@ -65,7 +65,7 @@ class Kernel final : public ContactKernel {
       : n_mat_(table.n_materials()), slots_(Model::history_slots()) {
     for (int a = 0; a < n_mat_; ++a)
       for (int b = 0; b < n_mat_; ++b) coeffs_.push_back(Model::coeffs(table(a, b), spec));
-    uniform_ = broadcast(0);
+    if (!coeffs_.empty()) uniform_ = broadcast(0);  // a scene without materials has no contacts
   }
   std::span<const HistorySlot> history_slots() const override { return slots_; }
 

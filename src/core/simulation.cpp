@@ -54,9 +54,10 @@ void Simulation::take_energy_baseline() {
   motion0_ = r.kinetic_energy + r.rotational_energy + r.elastic_energy;
   potential0_ = r.potential_energy;
   balance0_ = motion0_ + potential0_ + r.dissipated_energy - r.drive_work;
+  const double g = norm(scene_.run.gravity);
   double floor = 0.0;
   for (std::size_t k = 0; k < particles_.n_owned(); ++k)
-    floor += particles_.mass[k] * norm(scene_.run.gravity) * particles_.radius[k];
+    floor += particles_.mass[k] * g * particles_.radius[k];
   energy_floor_ = domain_->sum(floor);
   baseline_taken_ = true;
 }

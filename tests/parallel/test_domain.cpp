@@ -440,23 +440,8 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
   s.deck_path = "test_domain";
   s.materials.push_back(thesis_steel());
   s.run.dt_auto = true;
-  for (const auto& [a, b] :
-       {std::pair{Vec2{-0.4, 0.0}, Vec2{0.4, 0.0}}, std::pair{Vec2{-0.4, 0.0}, Vec2{-0.4, 0.6}},
-        std::pair{Vec2{0.4, 0.0}, Vec2{0.4, 0.6}}}) {
-    WallSpec w;
-    w.from = a;
-    w.to = b;
-    w.material = "steel";
-    s.walls.push_back(w);
-  }
-  FillSpec f;
-  f.material = "steel";
-  f.count = 150;
-  f.radius_min = 0.012;
-  f.radius_max = 0.02;
-  f.region = FillRegion::kBox;
-  f.box_min = {-0.35, 0.05};
-  f.box_max = {0.35, 0.5};
+  testing_support::add_open_box(s, 0.4, 0.6, "steel");
+  FillSpec f = testing_support::box_fill("steel", 150, 0.012, 0.02, {-0.35, 0.05}, {0.35, 0.5});
   f.velocity = {0.5, -0.5};
   s.fills.push_back(f);
   expect_same_as_serial(s, 20000, 2000);

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <iostream>
 #include <numbers>
-#include <utility>
 
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
@@ -144,24 +143,8 @@ PileResult pile(double e, IntegratorKind integrator) {
   s.deck_path = "hard cases";
   s.materials = {thesis_steel(e)};
   s.run.integrator = integrator;
-  for (const auto& [a, b] :
-       {std::pair{Vec2{-0.6, 0.0}, Vec2{0.6, 0.0}}, std::pair{Vec2{-0.6, 0.0}, Vec2{-0.6, 1.5}},
-        std::pair{Vec2{0.6, 0.0}, Vec2{0.6, 1.5}}}) {
-    WallSpec w;
-    w.from = a;
-    w.to = b;
-    w.material = "steel";
-    s.walls.push_back(w);
-  }
-  FillSpec f;
-  f.material = "steel";
-  f.count = 60;
-  f.radius_min = 0.04;
-  f.radius_max = 0.06;
-  f.region = FillRegion::kBox;
-  f.box_min = {-0.55, 0.3};
-  f.box_max = {0.55, 1.4};
-  s.fills = {f};
+  testing_support::add_open_box(s, 0.6, 1.5, "steel");
+  s.fills = {testing_support::box_fill("steel", 60, 0.04, 0.06, {-0.55, 0.3}, {0.55, 1.4})};
   s.run.duration = 1.5;
   Simulation sim(s);
   const auto balance = [](const SeriesRow& r) {

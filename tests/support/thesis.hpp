@@ -1,6 +1,8 @@
 // Shared test fixtures: the thesis's steel (seed 000, Table 1) and its drum.
 #pragma once
 
+#include <string>
+
 #include "core/scene.hpp"
 
 namespace dem2d::testing_support {
@@ -40,6 +42,35 @@ inline Scene thesis_drum_scene(int balls, double speed, int sides, double ramp_t
   f.region = FillRegion::kBottom;
   s.fills.push_back(f);
   return s;
+}
+
+// An open box of three `material` wall segments: the floor from (-half_width, 0) to
+// (half_width, 0) and two sides up to `height`.
+inline void add_open_box(Scene& s, double half_width, double height, const std::string& material) {
+  const Vec2 corners[3][2] = {{{-half_width, 0.0}, {half_width, 0.0}},
+                              {{-half_width, 0.0}, {-half_width, height}},
+                              {{half_width, 0.0}, {half_width, height}}};
+  for (const auto& c : corners) {
+    WallSpec w;
+    w.from = c[0];
+    w.to = c[1];
+    w.material = material;
+    s.walls.push_back(w);
+  }
+}
+
+// `count` particles of `material`, radii uniform in [r_min, r_max], placed in a box.
+inline FillSpec box_fill(const std::string& material, int count, double r_min, double r_max,
+                         Vec2 box_min, Vec2 box_max) {
+  FillSpec f;
+  f.material = material;
+  f.count = count;
+  f.radius_min = r_min;
+  f.radius_max = r_max;
+  f.region = FillRegion::kBox;
+  f.box_min = box_min;
+  f.box_max = box_max;
+  return f;
 }
 
 }  // namespace dem2d::testing_support
