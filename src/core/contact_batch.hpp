@@ -69,6 +69,7 @@ struct ContactBatch : BatchColumns<ContactBatch> {
   Array<double> fx, fy;    // force on i (on j: the opposite)
   Array<double> t_i, t_j;  // torques on i and on j
   Array<double> overlap;   // delta / min(r_i, r_j)
+  Array<double> ex, ey;    // the elastic normal force on i (ContactForceT::f_el)
 
   std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
     return {&dx,
@@ -88,7 +89,7 @@ struct ContactBatch : BatchColumns<ContactBatch> {
             &history.old[2],
             &history.old[3]};
   }
-  std::array<Array<double>*, 5> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap}; }
+  std::array<Array<double>*, 7> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap, &ex, &ey}; }
 };
 
 // The particle-wall contacts of one force evaluation, in the same three phases: the geometry
@@ -105,6 +106,7 @@ struct WallBatch : BatchColumns<WallBatch> {
   // Outputs (phase B).
   Array<double> fx, fy, torque, m_roll;
   Array<double> diss_law, el_law, diss_roll, el_roll;
+  Array<double> ex, ey;  // the elastic normal force (ContactForceT::f_el)
 
   std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
     return {&delta,
@@ -120,9 +122,9 @@ struct WallBatch : BatchColumns<WallBatch> {
             &history.old[2],
             &history.old[3]};
   }
-  std::array<Array<double>*, 12> outputs() {
-    return {&wx,     &wy,     &px,       &py,     &fx,        &fy,
-            &torque, &m_roll, &diss_law, &el_law, &diss_roll, &el_roll};
+  std::array<Array<double>*, 14> outputs() {
+    return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque,
+            &m_roll, &diss_law, &el_law, &diss_roll, &el_roll, &ex, &ey};
   }
 };
 

@@ -230,6 +230,8 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     const Pack spin = load(b_.spin, c);
     project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
     kin.omega_rel = load(b_.omega_rel, c);
+    kin.v_t_step = kin.v_t;
+    kin.omega_rel_step = kin.omega_rel;
     const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
@@ -256,6 +258,8 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     store(ti, b_.t_i, c);
     store(tj, b_.t_j, c);
     store(ratio, b_.overlap, c);
+    store(-cf.f_el * nx, b_.ex, c);
+    store(-cf.f_el * ny, b_.ey, c);
   }
 }
 
@@ -264,6 +268,7 @@ template <class Model>
 void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n) {
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
+  Vec2* f_el = p.elastic_force.data();
   double* trial = pl.trial.data();
   for (std::size_t c = 0; c < n; ++c) {
     const std::int32_t k = b_.pair[c];
@@ -273,6 +278,9 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
     f[j] -= fi;
     tq[i] += b_.t_i[c];
     tq[j] += b_.t_j[c];
+    const Vec2 ei{b_.ex[c], b_.ey[c]};
+    f_el[i] += ei;
+    f_el[j] -= ei;
     for (std::size_t s = 0; s < W; ++s)
       trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
   }
@@ -345,6 +353,8 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     if constexpr (Model::Rolling::kNeedsInertia) kin.i_eff = 1.4 * mi * ri * ri;
     project_velocity(kin, load(wb_.vx, c), load(wb_.vy, c), nx, ny);
     kin.omega_rel = load(wb_.omega_rel, c);
+    kin.v_t_step = kin.v_t;
+    kin.omega_rel_step = kin.omega_rel;
     const ContactResponseT<Pack> out = respond(wb_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
@@ -358,6 +368,8 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     store(cf.elastic, wb_.el_law, c);
     store(out.rolling.dissipated, wb_.diss_roll, c);
     store(out.rolling.elastic, wb_.el_roll, c);
+    store(-cf.f_el * nx, wb_.ex, c);
+    store(-cf.f_el * ny, wb_.ey, c);
   }
 }
 
@@ -366,6 +378,7 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
                                   std::size_t n, EvaluationTotals& tot) {
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
+  Vec2* f_el = p.elastic_force.data();
   const WallElement* elements = walls.elements().data();
   const WallBody* bodies = walls.bodies().data();
   const int drum = walls.drum_body();
@@ -379,6 +392,7 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
     const double m_roll = wb_.m_roll[c];
     f[i] += fi;
     tq[i] += wb_.torque[c];
+    f_el[i] += Vec2{wb_.ex[c], wb_.ey[c]};
     dissipated += wb_.diss_law[c];
     elastic += wb_.el_law[c];
     if constexpr (Model::Rolling::kActive) {

@@ -67,8 +67,10 @@ class StepStages {
   // Contact forces and torques at the current state into the accumulators (cleared first, the
   // owned ones unless `owned_cleared`); histories advanced by dt into the trial slots.
   virtual void contact_forces(double dt, bool owned_cleared) = 0;
-  // The trial histories become the committed ones; the step's energies are booked.
-  virtual void commit(double dt) = 0;
+  // The trial histories become the committed ones; the step's energies are booked, with
+  // `late_loss` (J) added to the dissipation the contact laws reported (Verlet's completion of
+  // their work to the end-of-step velocity).
+  virtual void commit(double dt, double late_loss) = 0;
 
  protected:
   ~StepStages() = default;
@@ -160,6 +162,7 @@ class VelocityVerlet final : public Integrator {
     double checksum = 0.0;
     double disp2 = 0.0, speed2 = 0.0;  // max |x - x_build|^2 and |v + a dt/2|^2 (owned)
     double motion2 = 0.0;              // max |v + a dt/2|^2 / r^2 (owned)
+    double late_loss = 0.0;            // J, see closing_kick
   };
   void kick_drift_owned(ParticleStore& p) const;
   Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
@@ -193,6 +196,8 @@ class IterativeIntegrator final : public Integrator {
   void save_start(const ParticleStore& p);
   void predict(ParticleStore& p) const;
   bool settled(const ParticleStore& p, Domain& domain);
+  double loss_power(const ParticleStore& p) const;
+  double late_loss(const ParticleStore& p, double booked_power) const;
   void largest_motion(const ParticleStore& p, StepOutcome& out) const;
   StepOutcome end_of_step_round(StepStages& s, double checksum) const;
 
@@ -203,6 +208,9 @@ class IterativeIntegrator final : public Integrator {
   // The state at the start of the step and the latest accelerations.
   Array<Vec2> x0_, v0_, a0_, a1_;
   Array<double> th0_, w0_, al0_, al1_;
+  // The previous step's loss forces and torques (late_loss).
+  Array<Vec2> g0_;
+  Array<double> m0_;
 };
 
 }  // namespace dem2d

@@ -134,6 +134,9 @@ class ParticleStore {
   // Force and torque accumulators of the current force evaluation (not state).
   Field<Vec2> force{"force", registry_, {"N", "force of the current evaluation"}};
   Field<double> torque{"torque", registry_, {"N m", "torque of the current evaluation"}};
+  // The elastic normal part of `force` (ContactForceT::f_el): the rest of the force and the
+  // whole torque do work the energy ledger books as dissipated.
+  Field<Vec2> elastic_force{"elastic_force", registry_, {"N", "elastic normal part of `force`"}};
 
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }

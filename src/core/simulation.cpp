@@ -128,17 +128,19 @@ void Simulation::refresh_ghosts() { domain_->refresh_ghosts(particles_, ghost_fi
 void Simulation::contact_forces(double dt, bool owned_cleared) {
   Vec2* f = particles_.force.data();
   double* tq = particles_.torque.data();
+  Vec2* e = particles_.elastic_force.data();
   for (std::size_t k = owned_cleared ? particles_.n_owned() : 0; k < particles_.size(); ++k) {
     f[k] = {};
     tq[k] = 0.0;
+    e[k] = {};
   }
   contacts_.evaluate(particles_, walls_, dt);
 }
 
-void Simulation::commit(double dt) {
+void Simulation::commit(double dt, double late_loss) {
   contacts_.commit();
   const EvaluationTotals& t = contacts_.totals();
-  dissipated_ += t.dissipated;
+  dissipated_ += t.dissipated + late_loss;
   drive_work_ += t.drive_power * dt;
 }
 

@@ -102,7 +102,7 @@ class Simulation final : private StepStages {
   void refresh_ghosts() override;
   std::span<FieldBase* const> ghost_fields() override { return ghost_fields_; }
   void contact_forces(double dt, bool owned_cleared) override;
-  void commit(double dt) override;
+  void commit(double dt, double late_loss) override;
 
   void choose_dt();
   [[noreturn]] void report_unstable(const StepOutcome& outcome);

@@ -132,8 +132,8 @@ ContactKinematics steel_kinematics(double delta, double v_n = 0.0, double v_t = 
   k.m_eff = 0.5 * m;
   k.i_eff = 0.5 * 1.4 * m * r * r;
   k.v_n = v_n;
-  k.v_t = v_t;
-  k.omega_rel = w_rel;
+  k.v_t = k.v_t_step = v_t;  // Verlet: the springs advance with the speeds the law sees
+  k.omega_rel = k.omega_rel_step = w_rel;
   return k;
 }
 
@@ -976,12 +976,14 @@ TEST(ModelSlots, ARollingModelNoPairUsesIsNotRun) {
 // The energy ledger of one oblique impact with friction and rolling resistance (issue: honest
 // numbers). Two steel spheres (r = 0.1 m) meet at 2 x (5, 3) m/s, offset so that they slide,
 // e = 0.05, mu_s = 0.3, without and with epsd rolling (mu_r = 0.05). The dissipated energy booked
-// by the laws must equal the mechanical energy lost, converging at first order in dt (the dashpots
-// see the half-step velocity), for every phase of the first touch within a step. Booked as the
-// derivative v_n dt / (2 delta) of the stiffness (before), the ledger overstated the loss by
-// 15 % to 4.4 times here, with no convergence in dt.
-double ledger_error(double dt, double phase, double mu_r) {
-  Scene s = base_scene(ContactModelKind::kHertzMindlin, RollingModelKind::kEpsd, dt);
+// by the laws must equal the mechanical energy lost, for every phase of the first touch within
+// a step. History of this figure: 15 % to 4.4 times off with the stiffness change booked as a
+// derivative; 6e-4, first order, with the losses booked at the half-step velocity and only the
+// dashpot booked while the spring holds; now the booking is the kicks' own work, and what is
+// left is the integrator's energy error and the spring energy a contact still holds in its last
+// step (below 1e-4 of the loss, without trend in dt).
+double ledger_error(ContactModelKind law, double dt, double phase, double mu_r) {
+  Scene s = base_scene(law, RollingModelKind::kEpsd, dt);
   s.materials = {steel(0.05, 0.3, mu_r)};
   // `phase` of a step's travel shifts where in a step the contact starts.
   s.particles = {ball("steel", 0.1, {-0.11, 0.0}, {5.0, 3.0}),
@@ -1003,17 +1005,20 @@ double ledger_error(double dt, double phase, double mu_r) {
   return r.dissipated_energy / loss - 1.0;
 }
 
-TEST(EnergyLedger, ObliqueImpactWithFrictionAndRollingConvergesAtFirstOrder) {
-  for (const double phase : {0.0, 0.25, 0.5, 0.75}) {
-    const double mu_r = phase < 0.5 ? 0.0 : 0.05;  // without and with rolling resistance
-    const double e1 = ledger_error(1.0e-6, phase, mu_r), e2 = ledger_error(5.0e-7, phase, mu_r),
-                 e4 = ledger_error(2.5e-7, phase, mu_r);
-    std::cout << "[ ledger ] oblique impact, mu_r " << mu_r << ", touch phase " << phase
-              << ": booked / lost - 1 = " << e1 << " (dt 1e-6), " << e2 << " (5e-7), " << e4
-              << " (2.5e-7)\n";
-    EXPECT_LT(std::abs(e1), 0.02) << "phase " << phase;
-    EXPECT_NEAR(e1 / e2, 2.0, 0.5) << "phase " << phase << ": first order, no floor";
-    EXPECT_NEAR(e2 / e4, 2.0, 0.5) << "phase " << phase << ": first order, no floor";
+TEST(EnergyLedger, ObliqueImpactWithFrictionAndRollingBooksTheLoss) {
+  for (const auto& [law, name] : {std::pair{ContactModelKind::kHertzMindlin, "hertz-mindlin"},
+                                  std::pair{ContactModelKind::kLinear, "linear"}}) {
+    for (const double phase : {0.0, 0.25, 0.5, 0.75}) {
+      const double mu_r = phase < 0.5 ? 0.0 : 0.05;  // without and with rolling resistance
+      std::cout << "[ ledger ] " << name << " oblique impact, mu_r " << mu_r << ", touch phase "
+                << phase << ": booked / lost - 1 =";
+      for (const double dt : {1.0e-6, 5.0e-7, 2.5e-7}) {
+        const double e = ledger_error(law, dt, phase, mu_r);
+        std::cout << " " << e << " (dt " << dt << ")";
+        EXPECT_LT(std::abs(e), 1e-4) << name << " phase " << phase << " dt " << dt;
+      }
+      std::cout << "\n";
+    }
   }
 }
 

@@ -150,10 +150,11 @@ TEST(SystemEnergy, ConservedWithoutDissipationLinear) {
 }
 
 // (b) Thesis steel with friction, damping and epsd rolling: 60 balls in a 8-gon drum spun up to
-// 1.8 rad/s, 1 s. The balance residual is first order in dt (velocity-dependent forces see the
-// half-step velocity): it must be small at the thesis dt and halve with dt, with no floor
-// (a floor would be a bookkeeping error, e.g. the work of a varying spring stiffness).
-TEST(SystemEnergy, BalanceResidualWithFrictionIsSmallAndFirstOrder) {
+// 1.8 rad/s, 1 s. Every loss is booked as the work Verlet's kicks actually do, so what remains
+// in the balance is the integrator's own energy error: second order in dt (each halving divides
+// it by about 4), with no floor (a floor would be a bookkeeping error). Measured before the
+// end-of-step completion of the losses: first order, 1.5e-3 of the dissipation at 1e-5 s.
+TEST(SystemEnergy, BalanceResidualWithFrictionIsSmallAndSecondOrder) {
   const double dts[] = {2e-5, 1e-5, 5e-6, 2.5e-6};
   double rel[4];
   for (int k = 0; k < 4; ++k) {
@@ -167,12 +168,11 @@ TEST(SystemEnergy, BalanceResidualWithFrictionIsSmallAndFirstOrder) {
               << " J, drive work " << r.drive_work << " J)\n";
     EXPECT_GT(r.dissipated_energy, 1e3);
   }
-  EXPECT_LT(std::abs(rel[1]), 0.01) << "at the thesis dt 1e-5 s";
+  EXPECT_LT(std::abs(rel[1]), 5e-4) << "at the thesis dt 1e-5 s";
   for (int k = 0; k + 1 < 4; ++k) {
     const double ratio = rel[k] / rel[k + 1];
-    EXPECT_GT(ratio, 1.6) << "halving dt from " << dts[k]
-                          << " s: residual not first order (floor?)";
-    EXPECT_LT(ratio, 2.6) << "halving dt from " << dts[k] << " s";
+    EXPECT_GT(ratio, 3.2) << "halving dt from " << dts[k] << " s: not second order (floor?)";
+    EXPECT_LT(ratio, 5.0) << "halving dt from " << dts[k] << " s";
   }
 }
 
