@@ -19,14 +19,25 @@
 
 namespace dem2d {
 
-// Most history slots a contact model may declare (law + rolling + tracker).
-inline constexpr std::size_t kMaxHistorySlots = 4;
+// Most history slots a contact model may declare (law + rolling + tracker + stepper).
+inline constexpr std::size_t kMaxHistorySlots = 8;
 
 // The history columns of a batch: slot s of contact c is old[s][c] before the step, fresh[s][c]
 // after it.
 struct HistoryColumns {
   std::array<Array<double>, kMaxHistorySlots> old, fresh;
 };
+
+// A batch's input columns followed by its old history columns (all of them are copied into the
+// padding lanes).
+template <std::size_t N>
+std::array<Array<double>*, N + kMaxHistorySlots> with_history(
+    const std::array<Array<double>*, N>& columns, HistoryColumns& h) {
+  std::array<Array<double>*, N + kMaxHistorySlots> out{};
+  for (std::size_t k = 0; k < N; ++k) out[k] = columns[k];
+  for (std::size_t s = 0; s < kMaxHistorySlots; ++s) out[N + s] = &h.old[s];
+  return out;
+}
 
 // What both batches share: the contact's list index and material pair, the history columns, and
 // sizing and padding driven by the derived batch's two column lists, `inputs()` (what phase B
@@ -72,22 +83,8 @@ struct ContactBatch : BatchColumns<ContactBatch> {
   Array<double> ex, ey;    // the elastic normal force on i (ContactForceT::f_el)
 
   std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
-    return {&dx,
-            &dy,
-            &dist2,
-            &r_i,
-            &r_j,
-            &m_i,
-            &m_j,
-            &vx,
-            &vy,
-            &spin,
-            &omega_rel,
-            &counted,
-            &history.old[0],
-            &history.old[1],
-            &history.old[2],
-            &history.old[3]};
+    return with_history<12>(
+        {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel, &counted}, history);
   }
   std::array<Array<double>*, 7> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap, &ex, &ey}; }
 };
@@ -109,18 +106,7 @@ struct WallBatch : BatchColumns<WallBatch> {
   Array<double> ex, ey;  // the elastic normal force (ContactForceT::f_el)
 
   std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
-    return {&delta,
-            &nx,
-            &ny,
-            &r,
-            &m,
-            &vx,
-            &vy,
-            &omega_rel,
-            &history.old[0],
-            &history.old[1],
-            &history.old[2],
-            &history.old[3]};
+    return with_history<8>({&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel}, history);
   }
   std::array<Array<double>*, 14> outputs() {
     return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque,

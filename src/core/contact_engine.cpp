@@ -36,6 +36,7 @@ template <class Model>
   for (Pack& v : out.law) v = load(h.old[s++], c);
   for (Pack& v : out.rolling) v = load(h.old[s++], c);
   for (Pack& v : out.tracker) v = load(h.old[s++], c);
+  for (Pack& v : out.stepper) v = load(h.old[s++], c);
   return out;
 }
 template <class Model>
@@ -45,6 +46,7 @@ template <class Model>
   for (const Pack& v : in.law) store(v, h.fresh[s++], c);
   for (const Pack& v : in.rolling) store(v, h.fresh[s++], c);
   for (const Pack& v : in.tracker) store(v, h.fresh[s++], c);
+  for (const Pack& v : in.stepper) store(v, h.fresh[s++], c);
 }
 
 std::size_t padded(std::size_t n) { return (n + kPackSize - 1) / kPackSize * kPackSize; }
@@ -230,8 +232,6 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     const Pack spin = load(b_.spin, c);
     project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
     kin.omega_rel = load(b_.omega_rel, c);
-    kin.v_t_step = kin.v_t;
-    kin.omega_rel_step = kin.omega_rel;
     const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
@@ -353,8 +353,6 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     if constexpr (Model::Rolling::kNeedsInertia) kin.i_eff = 1.4 * mi * ri * ri;
     project_velocity(kin, load(wb_.vx, c), load(wb_.vy, c), nx, ny);
     kin.omega_rel = load(wb_.omega_rel, c);
-    kin.v_t_step = kin.v_t;
-    kin.omega_rel_step = kin.omega_rel;
     const ContactResponseT<Pack> out = respond(wb_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
@@ -417,6 +415,16 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
   tot.max_overlap = max_ratio;
 }
 
+// The stepper follows the integrator (contact_models.hpp, Steppers).
+template <class Law, class Rolling, class Tracker>
+std::unique_ptr<ContactKernel> make_kernel(const ContactSpec& spec, const PairTable& table,
+                                           IntegratorKind integrator) {
+  if (integrator == IntegratorKind::kIterative)
+    return std::make_unique<Kernel<ContactModel<Law, Rolling, Tracker, StepTrapezoid>>>(spec,
+                                                                                        table);
+  return std::make_unique<Kernel<ContactModel<Law, Rolling, Tracker, StepAsSeen>>>(spec, table);
+}
+
 // The entry of a registry (a std::tuple of models) whose kKind is `kind`, handed to f as
 // std::type_identity<Model>.
 template <class Registry, class Kind, class F>
@@ -435,8 +443,8 @@ std::unique_ptr<ContactKernel> pick(Kind kind, F f) {
 // A rolling model is run only when some pair of materials has rolling friction: with mu_r = 0
 // everywhere it gives no torque and stores nothing (measured bit-identical to none), and the
 // epsd kernel cost 6 % more on such a scene.
-std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec,
-                                                   const PairTable& table) {
+std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table,
+                                                   IntegratorKind integrator) {
   bool rolling_friction = false;
   for (int a = 0; a < table.n_materials(); ++a)
     for (int b = 0; b < table.n_materials(); ++b) rolling_friction |= table(a, b).mu_r != 0.0;
@@ -446,14 +454,14 @@ std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec,
       using Law = typename decltype(law)::type;
       using Rolling = typename decltype(rolling)::type;
       if (spec.track_peak_energy)
-        return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackPeakEnergy>>>(spec, table);
-      return std::make_unique<Kernel<ContactModel<Law, Rolling, TrackNone>>>(spec, table);
+        return make_kernel<Law, Rolling, TrackPeakEnergy>(spec, table, integrator);
+      return make_kernel<Law, Rolling, TrackNone>(spec, table, integrator);
     });
   });
 }
 
 ContactEngine::ContactEngine(const Scene& scene)
-    : table_(scene), kernel_(make_contact_kernel(scene.contact, table_)) {
+    : table_(scene), kernel_(make_contact_kernel(scene.contact, table_, scene.run.integrator)) {
   pairs_.width = wall_pairs_.width = kernel_->history_slots().size();
 }
 

@@ -50,9 +50,10 @@ class ContactKernel {
   virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs,
                         WallPairList& wall_pairs, double dt, EvaluationTotals& totals) = 0;
 };
-// The kernel for the scene's law, rolling model (none when no pair of materials has rolling
-// friction) and tracker.
-std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table);
+// The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
+// and the stepper that matches the integrator.
+std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, const PairTable& table,
+                                                   IntegratorKind integrator);
 
 class ContactEngine {
  public:

@@ -1,7 +1,9 @@
 // Contact sub-models (physics.md sections 2-3), in three slots (style.md item 5):
 //   law      normal and tangential force: HertzMindlin, ThesisModel, LinearModel;
 //   rolling  rolling resistance: RollingNone, RollingConstant, RollingEpsd;
-//   tracker  what a contact records for other models: TrackNone, TrackPeakEnergy.
+//   tracker  what a contact records for other models: TrackNone, TrackPeakEnergy;
+//   stepper  the speeds that advance the springs over a step, which depend on the integrator:
+//            StepAsSeen (Verlet), StepTrapezoid (iterative).
 // Each sub-model is a small value type that owns
 //   - its coefficients: `Coeffs<V>` (V = double for one material pair, Pack for one pair per
 //     lane), made from the pair's mixed material properties by `coeffs(MaterialPair)`, with
@@ -10,7 +12,7 @@
 //     `History<T>` holds them. The contact's history is law + rolling + tracker slots, and the
 //     neighbour lists, migration and (later) checkpoints size themselves from it;
 //   - one static `evaluate`.
-// ContactModel<Law, Rolling, Tracker> composes them; the pair and wall paths of the force
+// ContactModel<Law, Rolling, Tracker, Stepper> composes them; the pair and wall paths of the force
 // kernel (contact_engine.cpp) call its one `evaluate`. The combination is chosen once at setup
 // (make_contact_kernel), so a scene pays only for the models it uses.
 //
@@ -49,8 +51,10 @@ struct KinematicsT {
   T v_n = T(0.0);        // m/s, > 0 while closing
   T v_t = T(0.0);        // m/s, sliding speed of i's contact point relative to j, along t
   T omega_rel = T(0.0);  // rad/s, w_i - w_j
-  // The step's mean sliding and rolling speeds, which advance the springs (Verlet: v_t and
-  // omega_rel, the half-step values; iterative: the mean of the step's start and end).
+  // The step's mean normal, sliding and rolling speeds, which advance the springs and give the
+  // overlap at the step's start (set by the stepper: Verlet, the half-step values above;
+  // iterative, the mean of the step's start and end).
+  T v_n_step = T(0.0);
   T v_t_step = T(0.0);
   T omega_rel_step = T(0.0);
 };
@@ -119,10 +123,10 @@ inline Coeffs<Pack> broadcast_coeffs(const Coeffs<double>& c) {
 inline double sign(double x) { return vsign(x); }
 
 // k(delta_old) / k(delta) for a stiffness ~ sqrt(delta) (Hertz), delta_old = delta - v_n dt the
-// overlap at the start of the step (0 if the contact began within it).
+// overlap at the start of the step (0 if the contact began within it), v_n the step's mean.
 template <class T>
 [[gnu::always_inline]] inline T hertz_stiffness_ratio(const KinematicsT<T>& k, double dt) {
-  return vsqrt(vmax(T(0.0), k.delta - k.v_n * dt) / k.delta);
+  return vsqrt(vmax(T(0.0), k.delta - k.v_n_step * dt) / k.delta);
 }
 
 // Tangential spring-dashpot with a Coulomb cap (hertz-mindlin and linear):
@@ -456,13 +460,52 @@ struct TrackPeakEnergy {
 };
 
 // ---------------------------------------------------------------------------------------------
-// The composed model: one law, one rolling model, one tracker.
+// Steppers: the speeds over a step that advance the tangential and rolling springs and give the
+// overlap at the step's start (the stiffness change). They must match the integrator's own
+// update of the positions, or the springs integrate at a lower order than the bodies.
 
-template <class T, class Law, class Rolling, class Tracker>
+// Velocity Verlet: the law sees the half-step velocities, which are the step's mean.
+struct StepAsSeen : NoHistory {
+  template <class T>
+  [[gnu::always_inline]] static void prepare(KinematicsT<T>& k, const History<T>&, History<T>&) {
+    k.v_n_step = k.v_n;
+    k.v_t_step = k.v_t;
+    k.omega_rel_step = k.omega_rel;
+  }
+};
+
+// The iterative scheme: the law sees the end-of-step velocities; the step's mean is taken with
+// the speeds the contact had at the end of the previous step (trapezoid rule, second order like
+// the scheme's x1 = x0 + dt (v0 + v1) / 2 + O(dt^3)). In a contact's first step the end speeds
+// are used (it began within the step).
+struct StepTrapezoid {
+  static constexpr std::array<HistorySlot, 4> kHistory{
+      {{"v_n_end", "m/s", "normal speed at the end of the last step"},
+       {"v_t_end", "m/s", "sliding speed at the end of the last step"},
+       {"omega_rel_end", "rad/s", "relative spin at the end of the last step"},
+       {"stepped", "1", "1 once the contact has lasted a whole step"}}};
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class T>
+  [[gnu::always_inline]] static void prepare(KinematicsT<T>& k, const History<T>& old,
+                                             History<T>& h) {
+    const auto stepped = old[3] > 0.5;
+    k.v_n_step = select(stepped, 0.5 * (old[0] + k.v_n), k.v_n);
+    k.v_t_step = select(stepped, 0.5 * (old[1] + k.v_t), k.v_t);
+    k.omega_rel_step = select(stepped, 0.5 * (old[2] + k.omega_rel), k.omega_rel);
+    h = {k.v_n, k.v_t, k.omega_rel, T(1.0)};
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// The composed model: one law, one rolling model, one tracker, one stepper.
+
+template <class T, class Law, class Rolling, class Tracker, class Stepper>
 struct ContactHistoryT {
   typename Law::template History<T> law{};
   typename Rolling::template History<T> rolling{};
   typename Tracker::template History<T> tracker{};
+  typename Stepper::template History<T> stepper{};
 };
 
 template <class T>
@@ -471,28 +514,33 @@ struct ContactResponseT {
   RollingTorqueT<T> rolling;
 };
 
-template <class LawT, class RollingT, class TrackerT>
+template <class LawT, class RollingT, class TrackerT, class StepperT = StepAsSeen>
 struct ContactModel {
   using Law = LawT;
   using Rolling = RollingT;
   using Tracker = TrackerT;
+  using Stepper = StepperT;
   static constexpr std::size_t kLawSlots = Law::kHistory.size();
   static constexpr std::size_t kRollingSlots = Rolling::kHistory.size();
-  static constexpr std::size_t kHistoryWidth = kLawSlots + kRollingSlots + Tracker::kHistory.size();
+  static constexpr std::size_t kHistoryWidth =
+      kLawSlots + kRollingSlots + Tracker::kHistory.size() + Stepper::kHistory.size();
   template <class T>
-  using History = ContactHistoryT<T, Law, Rolling, Tracker>;
+  using History = ContactHistoryT<T, Law, Rolling, Tracker, Stepper>;
   template <class V>
   struct Coeffs {
     typename Law::template Coeffs<V> law;
     typename Rolling::template Coeffs<V> rolling;
   };
 
-  // The declared slots, law first, then rolling, then tracker: the order of the values in the
-  // neighbour lists and in HistoryRecords.
+  // The declared slots, law first, then rolling, tracker and stepper: the order of the values in
+  // the neighbour lists and in HistoryRecords.
   static std::vector<HistorySlot> history_slots() {
-    std::vector<HistorySlot> out(Law::kHistory.begin(), Law::kHistory.end());
-    out.insert(out.end(), Rolling::kHistory.begin(), Rolling::kHistory.end());
-    out.insert(out.end(), Tracker::kHistory.begin(), Tracker::kHistory.end());
+    std::vector<HistorySlot> out;
+    out.reserve(kHistoryWidth);
+    for (const HistorySlot& s : Law::kHistory) out.push_back(s);
+    for (const HistorySlot& s : Rolling::kHistory) out.push_back(s);
+    for (const HistorySlot& s : Tracker::kHistory) out.push_back(s);
+    for (const HistorySlot& s : Stepper::kHistory) out.push_back(s);
     return out;
   }
   static Coeffs<double> coeffs(const MaterialPair& m, const ContactSpec& spec) {
@@ -512,13 +560,15 @@ struct ContactModel {
             broadcast_coeffs<Rolling::template Coeffs>(c.rolling)};
   }
 
-  // One contact (or one per lane): the law, then the rolling model on the law's normal force,
-  // then the tracker on both. Shared by particle-particle and particle-wall contacts.
+  // One contact (or one per lane): the stepper's speeds, the law, then the rolling model on the
+  // law's normal force, then the tracker on both. Shared by particle-particle and particle-wall
+  // contacts.
   template <class T, class C>
-  [[gnu::always_inline]] static ContactResponseT<T> evaluate(const C& c, const KinematicsT<T>& kin,
+  [[gnu::always_inline]] static ContactResponseT<T> evaluate(const C& c, KinematicsT<T> kin,
                                                              const History<T>& old, History<T>& h,
                                                              double dt) {
     ContactResponseT<T> out;
+    Stepper::prepare(kin, old.stepper, h.stepper);
     out.law = Law::evaluate(c.law, kin, old.law, h.law, dt);
     if constexpr (Rolling::kActive)
       out.rolling = Rolling::evaluate(c.rolling, kin, out.law, old.rolling, h.rolling, dt);

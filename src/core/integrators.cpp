@@ -54,6 +54,10 @@ double accelerations(ParticleStore& p, Vec2 gravity) {
 
 StepOutcome VelocityVerlet::step(StepStages& s) {
   ParticleStore& p = s.particles();
+  if (!elastic_cleared_) {  // the closing kick clears it after use; the set-up's forces did not
+    std::fill(p.elastic_force.data(), p.elastic_force.data() + p.n_owned(), Vec2{});
+    elastic_cleared_ = true;
+  }
   kick_drift_owned(p);  // v += a dt/2, x += v dt; force accumulators cleared
   s.advance_clock();
   if (rebuild_next_)  // decided in the previous step's round
@@ -78,7 +82,6 @@ void VelocityVerlet::kick_drift_owned(ParticleStore& p) const {
   const double* al = p.alpha.data();
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
-  Vec2* e = p.elastic_force.data();
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt_);
     x[k] = d.x;
@@ -87,7 +90,6 @@ void VelocityVerlet::kick_drift_owned(ParticleStore& p) const {
     th[k] += dt_ * d.w;
     f[k] = {};
     tq[k] = 0.0;
-    e[k] = {};
   }
 }
 
@@ -115,7 +117,7 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
   const double* inv_m = p.inv_mass.data();
   const double* inv_i = p.inv_inertia.data();
   const double* r = p.radius.data();
-  const Vec2* f_el = p.elastic_force.data();
+  Vec2* f_el = p.elastic_force.data();
   const Vec2 g = gravity_;
   double checksum = 0.0, disp2 = 0.0, speed2 = 0.0, motion2 = 0.0, late_power = 0.0;
 #pragma omp simd reduction(+ : checksum, late_power) reduction(max : disp2, speed2, motion2)
@@ -125,6 +127,7 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
     v[k] += h * a[k];
     w[k] += h * al[k];
     late_power += dot(f[k] - f_el[k], h * a[k]) + tq[k] * (h * al[k]);
+    f_el[k] = {};  // cleared here, where it is read, rather than with the force in kick_drift
     const double d2 = norm2(x[k] - x_build[k]);
     const double s2 = norm2(v[k] + h * a[k]);
     const double m2 = s2 / (r[k] * r[k]);

@@ -171,8 +171,9 @@ class VelocityVerlet final : public Integrator {
 
   double dt_;
   Vec2 gravity_;
-  bool rebuild_next_ = true;   // decided by the previous step's round
-  bool ghosts_ahead_ = false;  // the ghosts already hold this step's drifted state
+  bool rebuild_next_ = true;      // decided by the previous step's round
+  bool ghosts_ahead_ = false;     // the ghosts already hold this step's drifted state
+  bool elastic_cleared_ = false;  // the owned elastic forces are zero (closing_kick)
   // In parallel: the state the halo sources will drift to in the next step (their entries
   // only), sent to the ghosts in the end-of-step round.
   std::vector<FieldBase*> next_registry_;
