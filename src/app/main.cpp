@@ -213,9 +213,14 @@ bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, Snapshot
   series.write(sim.diagnostics());
   sim.reset_pass_window();
   if (out.snapshot_interval > 0) snapshot();
+  std::size_t guards_told = 0;  // run.guards = "warn": each kind is told when it first fires
   try {
     while (sim.time() + 0.5 * dt < scene.run.duration) {
       sim.step();
+      for (; guards_told < sim.guard_records().size(); ++guards_told)
+        say(scene.deck_path + ": warning: " + sim.guard_records()[guards_told].first +
+                " (run.guards = \"warn\": the run goes on)\n",
+            stderr);
       if (at_multiple(sim.time(), out.series_interval)) {
         series.write(sim.diagnostics());
         sim.reset_pass_window();
@@ -254,6 +259,10 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
                                                    std::max<std::int64_t>(1, sim.step_count())));
     info.extra.emplace_back("unconverged_steps", std::to_string(sim.unconverged_steps()));
   }
+  std::string guards = "{";
+  for (const GuardRecord& g : sim.guard_records())
+    guards += (guards.size() > 1 ? ", \"" : "\"") + g.kind + "\": " + std::to_string(g.count);
+  info.extra.emplace_back("guards_fired", guards + "}");
   // The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
   // ghosts, migrations and time in communication; the imbalance against equal angles.
   const DecompositionStats& ds = domain.stats();
@@ -311,7 +320,12 @@ int run(const Options& opt) {
             std::to_string(sim.unconverged_steps()) +
             " steps (run.max_passes = " + std::to_string(scene.run.max_passes) + ")\n",
         stderr);
-  return kExitOk;
+  if (sim.guard_records().empty()) return kExitOk;
+  for (const GuardRecord& g : sim.guard_records())
+    say(scene.deck_path + ": error: the " + g.kind + " guard fired " + std::to_string(g.count) +
+            (g.count == 1 ? " time" : " times") + " (first: " + g.first + ")\n",
+        stderr);
+  return kExitUnstable;  // the run went to its end (run.guards = "warn"), but it is not sane
 }
 
 }  // namespace

@@ -90,6 +90,14 @@ struct StepOutcome {
   // iterative: the step just taken, |x1 - x0| / r) and the id of the particle making it.
   double motion = 0.0;
   std::int64_t motion_id = -1;
+  // Iterative: the passes diverged (the largest change of the accelerations between passes grew
+  // fourfold from the second pass to the last without settling), the same on every rank; the
+  // two changes (relative, see IterativeIntegrator::largest_change) and this rank's particle of
+  // the last one.
+  bool diverged = false;
+  double change_first = 0.0, change_last = 0.0;
+  double change_mine = 0.0;  // this rank's largest change of the last pass
+  std::int64_t change_id = -1;
 };
 
 // Passes of force evaluation per step (always 1 for Verlet).
@@ -196,11 +204,11 @@ class IterativeIntegrator final : public Integrator {
   bool rebuild_due(StepStages& s) const;
   void save_start(const ParticleStore& p);
   void predict(ParticleStore& p) const;
-  bool settled(const ParticleStore& p, Domain& domain);
+  double largest_change(const ParticleStore& p, std::int64_t& id);
   double loss_power(const ParticleStore& p) const;
   double late_loss(const ParticleStore& p, double booked_power) const;
   void largest_motion(const ParticleStore& p, StepOutcome& out) const;
-  StepOutcome end_of_step_round(StepStages& s, double checksum) const;
+  StepOutcome end_of_step_round(StepStages& s, double checksum, StepOutcome out) const;
 
   double dt_;
   Vec2 gravity_;

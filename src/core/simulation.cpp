@@ -152,14 +152,38 @@ void Simulation::refresh_forces() {
 
 // ---------------------------------------------------------------------------------------------
 // A step went unstable on some rank: every rank builds the same message (the details take a
-// few more collectives, only now) and throws.
+// few more collectives, only now) and throws, or records it (run.guards = "warn").
 void Simulation::report_unstable(const StepOutcome& outcome) {
+  const bool finite = !domain_->any(!std::isfinite(outcome.checksum));
+  std::string kind;
+  std::ostringstream o;
+  o << "the run became unstable at step " << step_ << " (t = " << time_
+    << " s): " << unstable_reason(outcome, finite, kind) << "; dt = " << dt_
+    << " s, the safe dt is " << scales_.safe_dt << " s";
+  // Past the motion guard neither the contact search nor the decomposition's halo hold: it
+  // always stops, like a non-finite state.
+  if (finite && kind != "motion" && scene_.run.guards_warn) return guard_fired(kind, o.str());
+  const std::int64_t failed_step = step_;
+  const double failed_time = time_;
+  if (!finite) {
+    backup_.restore(particles_, time_, step_);
+    o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
+  }
+  throw UnstableError(o.str(), failed_step, failed_time);
+}
+
+std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
+                                        std::string& kind) {
   const EvaluationTotals& totals = contacts_.totals();
   const double max_overlap = domain_->max(totals.max_overlap);
-  const bool finite = !domain_->any(!std::isfinite(outcome.checksum));
+  // The particle named alike on every rank (ids are below 2^53): the one on the rank whose
+  // figure is the global one.
+  const auto agreed_id = [&](bool mine, std::int64_t id) {
+    return static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(id) : -2.0));
+  };
   std::ostringstream o;
-  o << "the run became unstable at step " << step_ << " (t = " << time_ << " s): ";
   if (!finite) {
+    kind = "finite";
     o << "non-finite positions or accelerations";
     // interface.md (exit 3) asks for the particle ids: name this rank's first few.
     int named = 0;
@@ -172,37 +196,43 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
       o << (named++ ? ", particle " : " of particle ") << p.id[k];
     }
   } else if (const double motion = domain_->max(outcome.motion); motion > kMaxStepMotion) {
-    const bool mine = outcome.motion == motion;
-    const auto id = static_cast<std::int64_t>(
-        domain_->max(mine ? static_cast<double>(outcome.motion_id) : -2.0));
-    o << "particle " << id << " moves " << motion << " times its radius in one step (at most "
-      << kMaxStepMotion << "): bodies could pass through each other";
-  } else {
-    // The pair at the largest overlap, named alike on every rank (ids are below 2^53).
+    kind = "motion";
+    o << "particle " << agreed_id(outcome.motion == motion, outcome.motion_id) << " moves "
+      << motion << " times its radius in one step (at most " << kMaxStepMotion
+      << "): bodies could pass through each other";
+  } else if (max_overlap > kMaxOverlapRatio) {
+    kind = "overlap";
     const bool mine = totals.max_overlap == max_overlap;
-    const auto worst_a =
-        static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_a) : -2.0));
-    const auto worst_b =
-        static_cast<std::int64_t>(domain_->max(mine ? static_cast<double>(totals.worst_b) : -2.0));
-    o << "overlap " << max_overlap << " of a radius between particle " << worst_a;
+    const std::int64_t worst_b = agreed_id(mine, totals.worst_b);
+    o << "overlap " << max_overlap << " of a radius between particle "
+      << agreed_id(mine, totals.worst_a);
     if (worst_b >= 0)
       o << " and particle " << worst_b;
     else
       o << " and a wall";
+  } else {
+    kind = "passes";
+    const double last = outcome.change_last;
+    o << "the iterative passes diverge: the largest relative change of the accelerations "
+      << "between passes grew from " << outcome.change_first << " to " << last << " (particle "
+      << agreed_id(outcome.change_mine == last, outcome.change_id)
+      << "); the passes converge only while omega_contact dt < sqrt(6)";
   }
-  o << "; dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt << " s";
-  const std::int64_t failed_step = step_;
-  const double failed_time = time_;
-  if (!finite) {
-    backup_.restore(particles_, time_, step_);
-    o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
-  }
-  throw UnstableError(o.str(), failed_step, failed_time);
+  return o.str();
+}
+
+void Simulation::guard_fired(const std::string& kind, const std::string& message) {
+  for (GuardRecord& g : guards_)
+    if (g.kind == kind) {
+      ++g.count;
+      return;
+    }
+  guards_.push_back({kind, 1, message});
 }
 
 // The balance kinetic + rotational + potential + elastic + dissipated - drive work is constant
 // up to the integrator's error. Grown beyond the tolerance, the run created energy.
-void Simulation::check_energy() const {
+void Simulation::check_energy() {
   const SeriesRow r = diagnostics();
   const double created = r.kinetic_energy + r.rotational_energy + r.potential_energy +
                          r.elastic_energy + r.dissipated_energy - r.drive_work - balance0_;
@@ -215,6 +245,7 @@ void Simulation::check_energy() const {
     << " of the " << through << " J that went through the system (at most "
     << kEnergyCreatedTolerance << "); dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt
     << " s";
+  if (scene_.run.guards_warn && std::isfinite(created)) return guard_fired("energy", o.str());
   throw UnstableError(o.str(), step_, time_);
 }
 

@@ -55,6 +55,13 @@ inline constexpr double kEnergyCreatedTolerance = 0.05;
 // The balance is checked every this many steps and at the deck's last step.
 inline constexpr std::int64_t kEnergyCheckSteps = 1000;
 
+// A guard that fired in a run with run.guards = "warn" (the run went on).
+struct GuardRecord {
+  std::string kind;        // "overlap", "motion", "energy" or "passes"
+  std::int64_t count = 0;  // steps (energy: checks, every kEnergyCheckSteps) at which it fired
+  std::string first;       // the message of the first time, as the stopping error would say it
+};
+
 class Simulation final : private StepStages {
  public:
   // Builds walls and particles from the scene and evaluates the initial forces. Throws
@@ -86,6 +93,9 @@ class Simulation final : private StepStages {
   std::int64_t unconverged_steps() const { return integrator_->passes().unconverged_steps; }
   int last_passes() const { return integrator_->passes().last; }
   const EvaluationTotals& last_totals() const { return contacts_.totals(); }
+  // The guards that fired (run.guards = "warn"), in the order they first fired; the same on
+  // every rank.
+  const std::vector<GuardRecord>& guard_records() const { return guards_; }
 
   // Force a neighbour-list rebuild (after particles were moved or added by hand).
   void rebuild() override;
@@ -105,10 +115,13 @@ class Simulation final : private StepStages {
   void commit(double dt, double late_loss) override;
 
   void choose_dt();
-  [[noreturn]] void report_unstable(const StepOutcome& outcome);
-  // Throws UnstableError when the energy balance shows energy created beyond
-  // kEnergyCreatedTolerance (collective).
-  void check_energy() const;
+  // A guard fired (collective: every rank builds the same message). Throws UnstableError,
+  // unless run.guards = "warn" and the state is finite: then it is recorded and the run goes on.
+  void report_unstable(const StepOutcome& outcome);
+  std::string unstable_reason(const StepOutcome& outcome, bool finite, std::string& kind);
+  void guard_fired(const std::string& kind, const std::string& message);
+  // The energy guard: energy created beyond kEnergyCreatedTolerance (collective).
+  void check_energy();
   void take_energy_baseline();
 
   Scene scene_;
@@ -135,6 +148,7 @@ class Simulation final : private StepStages {
   // Last known good state, saved every 1000 steps and after every rebuild.
   StateBackup backup_;
   std::int64_t builds_at_backup_ = 0;
+  std::vector<GuardRecord> guards_;
 };
 
 }  // namespace dem2d

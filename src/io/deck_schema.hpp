@@ -59,6 +59,10 @@ inline constexpr std::array kIntegrators = {
     Choice<IntegratorKind>{"verlet", IntegratorKind::kVerlet},
     Choice<IntegratorKind>{"iterative", IntegratorKind::kIterative},
 };
+inline constexpr std::array kGuardModes = {
+    Choice<bool>{"stop", false},
+    Choice<bool>{"warn", true},
+};
 inline constexpr std::array kFillRegions = {
     Choice<FillRegion>{"bottom", FillRegion::kBottom},
     Choice<FillRegion>{"full", FillRegion::kFull},
@@ -305,6 +309,16 @@ inline constexpr Key<RunSpec> kRunKeys[] = {
      .field = member<&RunSpec::max_passes>(),
      .doc = "iterative only: passes per step before the step is accepted unconverged "
             "(counted in `run.json`)"},
+    {.name = "guards",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kGuardModes>,
+     .field = choice<&RunSpec::guards_warn, kGuardModes>(),
+     .doc = "what the run's guards do when one fires (an overlap past 0.25 of the smaller "
+            "radius, energy created beyond 5 % of what went through the system, iterative "
+            "passes that diverge): `\"stop\"` ends the run with exit 3; `\"warn\"` tells each "
+            "kind when it first fires and runs to the end, which then exits 3 all the same. A "
+            "non-finite state and a particle moving more than 0.25 of its radius in one step "
+            "always stop"},
     {.name = "seed",
      .type = Type::kInteger,
      .range = kNonNegative,

@@ -89,5 +89,19 @@ expect "unstable run np2 exits 3" 3 'unstable at step [0-9]+.*particle [0-9]+ (a
   mpirun -np 2 --oversubscribe "$dem2d" "$src/inputs/centrifuge.in" --quiet --set run.dt=5e-4 \
   --set run.allow_unsafe_dt=true --set run.duration=0.3 --output "$tmp/boom2"
 
+# run.guards = "warn": a head-on impact at 8 x the safe dt creates energy; the guard is told as
+# it fires, the run goes to its end (last row and run.json written) and still exits 3, on 1 and
+# 2 ranks. The motion guard (bodies passing through each other) always stops.
+for np in 1 2; do
+  expect "guards warn np$np runs to the end, exits 3" 3 'error: the energy guard fired 1 time \(first: the run became unstable at step [0-9]+ .*energy was created' -- \
+    mpirun -np "$np" --oversubscribe "$dem2d" "$src/inputs/impact.in" --quiet --set run.dt=1.56e-4 \
+    --set run.allow_unsafe_dt=true --set run.guards=warn --output "$tmp/warn$np"
+  grep -q '"guards_fired": {"energy": 1}' "$tmp/warn$np/run.json" && pass "np$np run.json guards_fired" || fail "np$np run.json guards_fired"
+  awk -F, 'END { exit !($1 > 0.0099) }' "$tmp/warn$np/series.csv" && pass "np$np warn run wrote its last row" || fail "np$np warn run last row"
+done
+expect "guards warn: the motion guard still stops" 3 'error: the run became unstable at step 140 .*moves [0-9.e+-]+ times its radius' -- \
+  "$dem2d" "$src/inputs/centrifuge.in" --quiet --set run.dt=5e-4 --set run.allow_unsafe_dt=true \
+  --set run.duration=0.3 --set run.guards=warn --output "$tmp/warn_motion"
+
 echo "cli: $failures failure(s)"
 [ "$failures" -eq 0 ]

@@ -429,6 +429,72 @@ TEST(Stability, EnergyCreatedIsAnError) {
   }
 }
 
+// The same run with run.guards = "warn": the energy guard is recorded (kind, count, the message
+// a stopping run would give) and the run goes on to its end.
+TEST(Stability, GuardsCanWarnAndTheRunGoesOn) {
+  Scene s = base_scene(IntegratorKind::kVerlet);
+  s.materials[0] = thesis_steel(0.73);
+  s.run.gravity = {0.0, 0.0};
+  s.run.duration = 0.01;
+  add_ball(s, {-0.11, 0.0}, {5.0, 0.0}, 0.1);
+  add_ball(s, {0.11, 0.0}, {-5.0, 0.0}, 0.1);
+  const double safe = Simulation(s).dt();
+  s.run.dt_auto = false;
+  s.run.dt = 8.0 * safe;
+  s.run.allow_unsafe_dt = true;
+  s.run.guards_warn = true;
+  Simulation sim(s);
+  EXPECT_NO_THROW(sim.run_until(s.run.duration));
+  EXPECT_GE(sim.time() + 0.5 * sim.dt(), s.run.duration);
+  ASSERT_EQ(sim.guard_records().size(), 1U);
+  EXPECT_EQ(sim.guard_records()[0].kind, "energy");
+  EXPECT_EQ(sim.guard_records()[0].count, 1);
+  EXPECT_NE(sim.guard_records()[0].first.find("energy was created"), std::string::npos);
+}
+
+// The iterative scheme's passes are a fixed-point iteration that contracts only while
+// omega_contact dt < sqrt(6). A ball resting on a floor (omega_contact about 3600 rad/s) at
+// dt = 1 ms: the change of the accelerations between passes grows (over 4 times from the second
+// pass to the last) instead of settling, and the step is an error naming the step and the
+// particle, where before it was taken unconverged and counted. At the safe dt every step
+// converges.
+TEST(Stability, DivergingIterativePassesAreAnError) {
+  Scene s = base_scene(IntegratorKind::kIterative);
+  s.materials[0] = thesis_steel(0.5);
+  WallSpec floor;
+  floor.from = {-1.0, 0.0};
+  floor.to = {1.0, 0.0};
+  floor.material = "steel";
+  s.walls = {floor};
+  const double r = 0.05, m = 4.0 / 3.0 * std::numbers::pi * r * r * r * 7800.0;
+  const double e_star = 2.0e11 / (2.0 * (1.0 - 0.25 * 0.25));
+  const double delta0 = std::pow(m * 9.81 / (4.0 / 3.0 * e_star * std::sqrt(r)), 2.0 / 3.0);
+  add_ball(s, {0.0, r - delta0}, {0.01, 0.0}, r);
+  s.run.duration = 0.01;
+  {
+    Simulation sim(s);
+    EXPECT_NO_THROW(sim.run_until(s.run.duration));
+    EXPECT_EQ(sim.unconverged_steps(), 0) << "at the safe dt " << sim.dt() << " s";
+  }
+  s.run.dt_auto = false;
+  s.run.dt = 1.0e-3;
+  s.run.allow_unsafe_dt = true;
+  Simulation sim(s);
+  std::string what;
+  std::int64_t step = -1;
+  try {
+    sim.run_until(s.run.duration);
+  } catch (const UnstableError& e) {
+    what = e.what();
+    step = e.step();
+  }
+  std::cout << "[ passes ] " << what << "\n";
+  EXPECT_GE(step, 1);
+  EXPECT_LE(step, 2) << "stopped at once, not taken and counted";
+  EXPECT_NE(what.find("the iterative passes diverge"), std::string::npos) << what;
+  EXPECT_NE(what.find("(particle 0)"), std::string::npos) << what;
+}
+
 // Non-finite blow-up: two balls given the same centre (their contact normal is 0/0) among
 // others in a drum. interface.md (exit 3): "non-finite values, or an overlap beyond a safe
 // fraction of a radius: report step, time, particle ids, and the dt that would be safe". The
