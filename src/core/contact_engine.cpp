@@ -74,9 +74,22 @@ class Kernel final : public ContactKernel {
   void evaluate(ParticleStore& p, const Walls& walls, PairList& pl, WallPairList& wl, double dt,
                 EvaluationTotals& tot) override {
     tot = EvaluationTotals{};
+    released_ = 0.0;
+    if constexpr (kSpringSlots > 0) {
+      if (rescan_) find_live(pl, wl);
+      release_ended(p, walls, pl, wl, dt);
+      next_live_pairs_.clear();
+      next_live_walls_.clear();
+    }
     pair_contacts(p, pl, dt, tot);
     wall_contacts(p, walls, wl, dt, tot);
+    tot.dissipated += released_;
   }
+  void committed() override {
+    live_pairs_.swap(next_live_pairs_);
+    live_walls_.swap(next_live_walls_);
+  }
+  void lists_changed() override { rescan_ = true; }
 
  private:
   typename Model::template Coeffs<Pack> broadcast(std::int32_t k) const {
@@ -105,6 +118,18 @@ class Kernel final : public ContactKernel {
 
   void pair_contacts(ParticleStore& p, PairList& pl, double dt, EvaluationTotals& tot);
   std::size_t gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1);
+  void find_live(const PairList& pl, const WallPairList& wl);
+  void release_ended(const ParticleStore& p, const Walls& walls, const PairList& pl,
+                     const WallPairList& wl, double dt);
+  static bool holds_energy(const double* h) {
+    bool any = false;
+    for (std::size_t s = 0; s < kSpringSlots; ++s) any |= h[s] != 0.0;
+    return any;
+  }
+  void release_pair(const ParticleStore& p, std::int32_t i, std::int32_t j, double dt,
+                    const double* h);
+  void release_wall(const ParticleStore& p, const Walls& walls, std::int32_t i,
+                    std::int32_t element, double dt, const double* h);
   void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
@@ -118,6 +143,15 @@ class Kernel final : public ContactKernel {
   std::vector<Coeffs> coeffs_;  // [a * n_mat_ + b]
   typename Model::template Coeffs<Pack> uniform_;
   std::vector<HistorySlot> slots_;
+  // The slots that hold spring energy (law and rolling), and the energy released this
+  // evaluation by contacts that ended (J, this rank's share).
+  static constexpr std::size_t kSpringSlots = Model::kLawSlots + Model::kRollingSlots;
+  double released_ = 0.0;
+  // The list entries in contact in the committed histories (the only ones that can end in this
+  // step), and those in contact in this evaluation (committed next). After a rebuild they are
+  // found again from the histories (rescan_).
+  std::vector<std::int32_t> live_pairs_, live_walls_, next_live_pairs_, next_live_walls_;
+  bool rescan_ = true;
   ContactBatch b_;
   WallBatch wb_;
 };
@@ -157,9 +191,69 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
   tot.max_overlap = max_ratio;
 }
 
-// A. Gather the pairs in contact among candidates [k0, k1); pairs apart lose their history.
-// Branch-free compaction: every candidate is written to slot n and n advances only for a
-// contact (whether a candidate touches is close to random, so a branch here mispredicts often).
+// A contact that ended in this step releases the energy its springs held at the end of the last
+// step, at the overlap then: booked as dissipated (docs/output.md). Rare: out of line.
+template <class Model>
+[[gnu::noinline]] void Kernel<Model>::release_pair(const ParticleStore& p, std::int32_t i,
+                                                   std::int32_t j, double dt, const double* h) {
+  if (static_cast<std::size_t>(i) >= p.n_owned()) return;  // booked where i is owned
+  // x_j - x_i a step ago: before the drift dt v (Verlet: exactly the drift just taken).
+  const Vec2 d_old = (p.pos[j] - p.pos[i]) - dt * (p.vel[j] - p.vel[i]);
+  const double ri = p.radius[i], rj = p.radius[j];
+  const double delta_old = ri + rj - norm(d_old);
+  const auto& c = coeffs_[p.material[i] * n_mat_ + p.material[j]];
+  released_ += Model::spring_energy(c, ri * rj / (ri + rj), delta_old, h);
+}
+
+template <class Model>
+[[gnu::noinline]] void Kernel<Model>::release_wall(const ParticleStore& p, const Walls& walls,
+                                                   std::int32_t i, std::int32_t element, double dt,
+                                                   const double* h) {
+  const WallGeometry g = walls.geometry(element, p.pos[i], p.radius[i]);
+  const WallElement& e = walls.elements()[element];
+  const Vec2 v_rel = p.vel[i] - walls.velocity_at(e.body, g.point);
+  const double delta_old = g.delta - dt * dot(v_rel, g.n);  // closing along n, from i to the wall
+  const auto& c = coeffs_[p.material[i] * n_mat_ + e.material];
+  released_ += Model::spring_energy(c, p.radius[i], delta_old, h);
+}
+
+// The entries whose committed history holds spring energy (after a rebuild: rare).
+template <class Model>
+void Kernel<Model>::find_live(const PairList& pl, const WallPairList& wl) {
+  live_pairs_.clear();
+  live_walls_.clear();
+  for (std::size_t k = 0; k < pl.size(); ++k)
+    if (holds_energy(pl.history.data() + k * W))
+      live_pairs_.push_back(static_cast<std::int32_t>(k));
+  for (std::size_t k = 0; k < wl.size(); ++k)
+    if (holds_energy(wl.history.data() + k * W))
+      live_walls_.push_back(static_cast<std::int32_t>(k));
+  rescan_ = false;
+}
+
+// The contacts of the committed state that are apart now release what their springs held.
+template <class Model>
+void Kernel<Model>::release_ended(const ParticleStore& p, const Walls& walls, const PairList& pl,
+                                  const WallPairList& wl, double dt) {
+  for (const std::int32_t k : live_pairs_) {
+    const double* h = pl.history.data() + static_cast<std::size_t>(k) * W;
+    const std::int32_t i = pl.i[k], j = pl.j[k];
+    const double rsum = p.radius[i] + p.radius[j];
+    if (norm2(p.pos[j] - p.pos[i]) >= rsum * rsum && holds_energy(h)) release_pair(p, i, j, dt, h);
+  }
+  for (const std::int32_t k : live_walls_) {
+    const double* h = wl.history.data() + static_cast<std::size_t>(k) * W;
+    const std::int32_t i = wl.particle[k];
+    const bool touching = walls.touches(wl.element[k], p.pos[i], p.radius[i]) &&
+                          walls.geometry(wl.element[k], p.pos[i], p.radius[i]).delta > 0.0;
+    if (!touching && holds_energy(h)) release_wall(p, walls, i, wl.element[k], dt, h);
+  }
+}
+
+// A. Gather the pairs in contact among candidates [k0, k1); pairs apart lose their history (what
+// their springs held is released: release_ended). Branch-free compaction: every candidate is
+// written to slot n and n advances only for a contact (whether a candidate touches is close to
+// random, so a branch here mispredicts often).
 template <class Model>
 std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
                                         std::size_t k1) {
@@ -281,6 +375,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
     const Vec2 ei{b_.ex[c], b_.ey[c]};
     f_el[i] += ei;
     f_el[j] -= ei;
+    if constexpr (kSpringSlots > 0) next_live_pairs_.push_back(k);
     for (std::size_t s = 0; s < W; ++s)
       trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
   }
@@ -391,6 +486,7 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
     f[i] += fi;
     tq[i] += wb_.torque[c];
     f_el[i] += Vec2{wb_.ex[c], wb_.ey[c]};
+    if constexpr (kSpringSlots > 0) next_live_walls_.push_back(k);
     dissipated += wb_.diss_law[c];
     elastic += wb_.el_law[c];
     if constexpr (Model::Rolling::kActive) {
@@ -467,6 +563,7 @@ ContactEngine::ContactEngine(const Scene& scene)
 
 void ContactEngine::build(const ParticleStore& p, const Walls& walls, double skin) {
   search_.build(p, walls, skin, pairs_, wall_pairs_);
+  kernel_->lists_changed();
 }
 
 void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
@@ -476,6 +573,7 @@ void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
 void ContactEngine::commit() {
   pairs_.history.swap(pairs_.trial);
   wall_pairs_.history.swap(wall_pairs_.trial);
+  kernel_->committed();
 }
 
 HistoryRecords ContactEngine::records() const {
@@ -524,6 +622,7 @@ void ContactEngine::adopt(const HistoryRecords& records) {
   wl.particle.resize(wl.id.size());
   pairs_ = std::move(pl);
   wall_pairs_ = std::move(wl);
+  kernel_->lists_changed();
 }
 
 std::vector<double> ContactEngine::particle_work(std::size_t n_owned) const {

@@ -49,6 +49,9 @@ class ContactKernel {
   // written; totals of this rank.
   virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs,
                         WallPairList& wall_pairs, double dt, EvaluationTotals& totals) = 0;
+  // The last evaluation's histories were committed / the lists were rebuilt or replaced.
+  virtual void committed() = 0;
+  virtual void lists_changed() = 0;
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.

@@ -228,6 +228,15 @@ struct HertzMindlin : TangentialSpringHistory {
                       k.v_t, k.v_t_step, dt, old[0], h[0], out);
     return out;
   }
+  // The normal tangent stiffness and the energy the springs hold at overlap delta (what a
+  // contact that ends releases: contact_engine.cpp, release).
+  static double normal_stiffness(const Coeffs<double>& c, double r_eff, double delta) {
+    return 2.0 * c.e_star * std::sqrt(r_eff * std::max(delta, 0.0));
+  }
+  static double spring_energy(const Coeffs<double>& c, double r_eff, double delta,
+                              const double* h) {
+    return 0.5 * 8.0 * c.g_star * std::sqrt(r_eff * std::max(delta, 0.0)) * h[0] * h[0];
+  }
 };
 
 // The thesis's law as written (T9-T23): Hertz stiffness k_n = 4/3 E* sqrt(R* delta) (T11),
@@ -271,6 +280,10 @@ struct ThesisModel : NoHistory {
     out.strain = 0.5 * f_el * k.delta;
     return out;
   }
+  static double normal_stiffness(const Coeffs<double>& c, double r_eff, double delta) {
+    return 2.0 * c.e_star * std::sqrt(r_eff * std::max(delta, 0.0));
+  }
+  static double spring_energy(const Coeffs<double>&, double, double, const double*) { return 0.0; }
 };
 
 // Linear spring-dashpot (Cundall & Strack 1979): k_n constant per pair (or 4/3 E* 0.1 R*),
@@ -316,6 +329,14 @@ struct LinearModel : TangentialSpringHistory {
                       k.v_t_step, dt, old[0], h[0], out);
     return out;
   }
+  static double normal_stiffness(const Coeffs<double>& c, double r_eff, double) {
+    return c.kn_const + c.kn_per_radius * r_eff;
+  }
+  // Constant stiffness: the whole 1/2 k_t xi^2 is released at once when the contact ends.
+  static double spring_energy(const Coeffs<double>& c, double r_eff, double delta,
+                              const double* h) {
+    return 0.5 * (2.0 / 7.0) * normal_stiffness(c, r_eff, delta) * h[0] * h[0];
+  }
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -334,6 +355,7 @@ struct RollingNone : NoHistory {
     }
   };
   static Coeffs<double> coeffs(const MaterialPair&, double) { return {}; }
+  static double spring_energy(const Coeffs<double>&, double, double, const double*) { return 0.0; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C&, const KinematicsT<T>&,
                                                            const ContactForceT<T>&,
@@ -356,6 +378,7 @@ struct RollingConstant : NoHistory {
     }
   };
   static Coeffs<double> coeffs(const MaterialPair& m, double) { return {m.mu_r}; }
+  static double spring_energy(const Coeffs<double>&, double, double, const double*) { return 0.0; }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
                                                            const ContactForceT<T>& cf,
@@ -392,6 +415,11 @@ struct RollingEpsd {
   };
   static Coeffs<double> coeffs(const MaterialPair& m, double rolling_damping) {
     return {m.mu_r, rolling_damping};
+  }
+  // M^2 / (2 k_r) at the law's normal stiffness k_n.
+  static double spring_energy(const Coeffs<double>& c, double k_n, double r_eff, const double* h) {
+    const double k_r = 2.25 * k_n * c.mu_r * c.mu_r * r_eff * r_eff;
+    return k_r > 0.0 ? 0.5 * h[0] * h[0] / k_r : 0.0;
   }
   template <class T, class C>
   [[gnu::always_inline]] static RollingTorqueT<T> evaluate(const C& c, const KinematicsT<T>& k,
@@ -554,6 +582,14 @@ struct ContactModel {
                 [&](auto l) -> const LawC& { return table[index(l)].law; }),
             gather_coeffs<Rolling::template Coeffs>(
                 [&](auto l) -> const RollC& { return table[index(l)].rolling; })};
+  }
+  // The energy the springs of a contact hold at overlap delta, with the history `h` (its slots
+  // in declaration order): what the contact releases when it ends.
+  static double spring_energy(const Coeffs<double>& c, double r_eff, double delta,
+                              const double* h) {
+    return Law::spring_energy(c.law, r_eff, delta, h) +
+           Rolling::spring_energy(c.rolling, Law::normal_stiffness(c.law, r_eff, delta), r_eff,
+                                  h + kLawSlots);
   }
   static Coeffs<Pack> broadcast(const Coeffs<double>& c) {
     return {broadcast_coeffs<Law::template Coeffs>(c.law),

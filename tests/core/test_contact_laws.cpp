@@ -1042,6 +1042,36 @@ TEST(EnergyLedger, ObliqueImpactBooksTheLossWithTheIterativeIntegratorToo) {
   }
 }
 
+// A contact that ends releases what its springs held at the overlap of its last step
+// (contact_engine.cpp, release_ended): Model::spring_energy must be exactly the spring part of
+// the elastic energy the laws report there (a held spring, no motion in the step).
+TEST(EnergyLedger, TheEnergyAContactReleasesIsWhatItsSpringsHeld) {
+  const MaterialPair pair = steel_pair(0.73, 0.5, 0.05);
+  const ContactKinematics k = steel_kinematics(2.0e-6);
+  const ContactHistory old{1.0e-7, 0.02};
+  ContactHistory h;
+  const auto check = [&](auto law_tag, const char* name) {
+    using Law = typename decltype(law_tag)::type;
+    using Model = ContactModel<Law, RollingEpsd, TrackNone>;
+    const ContactForce f = law<Law>(pair, k, old, h, 0.0);
+    const RollingTorque m = rolling<RollingEpsd>(pair, k, f, old, h, 0.0, 0.3);
+    const double normal =
+        Law::kKind == ContactModelKind::kLinear ? 0.5 * f.f_el * k.delta : 0.4 * f.f_el * k.delta;
+    const double held = f.elastic - normal + m.elastic;
+    const double history[2] = {old.xi, old.m_roll};
+    const double released =
+        Model::spring_energy(Model::coeffs(pair, ContactSpec{}), k.r_eff, k.delta,
+                             Law::kHistory.size() == 1 ? history : history + 1);
+    std::cout << "[ release ] " << name << ": springs held " << held << " J, released " << released
+              << " J\n";
+    EXPECT_GT(held, 0.0) << name;
+    EXPECT_NEAR(released, held, 1e-12 * held) << name;
+  };
+  check(std::type_identity<HertzMindlin>{}, "hertz-mindlin");
+  check(std::type_identity<LinearModel>{}, "linear");
+  check(std::type_identity<ThesisModel>{}, "thesis");
+}
+
 // A ball resting on a floor at its Hertz overlap, pushed sideways at 1 cm/s with friction high
 // enough that it never slides: the tangential spring rocks it back and forth, a smooth motion
 // without impacts. The error of its kinetic + rotational energy after 1 ms against a run at
