@@ -205,15 +205,19 @@ StepOutcome IterativeIntegrator::step(StepStages& s) {
     s.contact_forces(dt_, /*owned_cleared=*/false);
     checksum = accelerations(p, gravity_);
     ++pass;
+    passes.change_first = passes.change_last;
     passes.change_mine = largest_change(p, passes.change_id);
     passes.change_last = s.domain().max(passes.change_mine);
-    if (pass == 2) passes.change_first = passes.change_last;
     converged = pass > 1 && passes.change_last <= tolerance_;
   }
-  // Not settled: passes that cycle (a contact or a friction direction that flips between
-  // passes) leave a bounded change and the step is taken (counted); passes that diverge (dt too
-  // large for the fixed point: omega_contact dt > sqrt(6)) grow it, and the step is an error.
-  passes.diverged = !converged && pass >= 3 && passes.change_last > 4.0 * passes.change_first;
+  // Not settled: passes that cycle mildly (an epsd branch, a friction direction or a light
+  // contact that flips between passes) leave accelerations that differ by less than their size,
+  // and the step is taken (counted). When the last two passes' accelerations differ by more than
+  // kMaxUnsettledChange times their size, no pass is a usable answer (a stiff contact on in one
+  // pass and off in the next, or passes that grow: dt too large for the fixed point,
+  // omega_contact dt > sqrt(6)), and the step is an error.
+  passes.diverged = !converged && pass >= 2 &&
+                    std::max(passes.change_first, passes.change_last) > kMaxUnsettledChange;
   const double booked_power = loss_power(p);
   predict(p);  // the final state from the last accelerations (p.acc holds a1 for the next step)
   if (!converged) ++passes_.unconverged_steps;

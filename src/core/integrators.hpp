@@ -90,10 +90,10 @@ struct StepOutcome {
   // iterative: the step just taken, |x1 - x0| / r) and the id of the particle making it.
   double motion = 0.0;
   std::int64_t motion_id = -1;
-  // Iterative: the passes diverged (the largest change of the accelerations between passes grew
-  // fourfold from the second pass to the last without settling), the same on every rank; the
-  // two changes (relative, see IterativeIntegrator::largest_change) and this rank's particle of
-  // the last one.
+  // Iterative: the passes did not settle and the last two changed the accelerations by more than
+  // IterativeIntegrator::kMaxUnsettledChange times their size, the same on every rank; the
+  // largest relative changes of the last two passes (IterativeIntegrator::largest_change) and
+  // this rank's particle of the last one.
   bool diverged = false;
   double change_first = 0.0, change_last = 0.0;
   double change_mine = 0.0;  // this rank's largest change of the last pass
@@ -198,6 +198,8 @@ class IterativeIntegrator final : public Integrator {
  public:
   IterativeIntegrator(double dt, Vec2 gravity, double tolerance, int max_passes)
       : dt_(dt), gravity_(gravity), tolerance_(tolerance), max_passes_(max_passes) {}
+  // Unsettled passes whose last two changes exceed this (relative to |a| + |g|) are an error.
+  static constexpr double kMaxUnsettledChange = 4.0;
   StepOutcome step(StepStages& s) override;
 
  private:

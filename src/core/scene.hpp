@@ -56,8 +56,8 @@ struct RunSpec {
   double skin = -1.0;            // m, Verlet skin; < 0: 0.4 of the smallest radius (core)
   double dt_safety = 0.2;        // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
   bool allow_unsafe_dt = false;  // run anyway (with a warning) when dt exceeds the safe bound
-  // The run's guards (overlap, energy created, diverging passes): false, the first one that
-  // fires stops the run (exit 3); true, each is reported and the run goes on to its end, which
+  // The run's guards (overlap, energy created, unsettled iterative passes): false, the first one
+  // that fires stops the run (exit 3); true, each is reported and the run goes on to its end, which
   // then exits 3 all the same. A non-finite state and the motion guard always stop.
   bool guards_warn = false;
   int sectors_per_rank = 32;  // parallel runs: angular sectors per rank (METIS groups them)

@@ -213,10 +213,11 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
   } else {
     kind = "passes";
     const double last = outcome.change_last;
-    o << "the iterative passes diverge: the largest relative change of the accelerations "
-      << "between passes grew from " << outcome.change_first << " to " << last << " (particle "
-      << agreed_id(outcome.change_mine == last, outcome.change_id)
-      << "); the passes converge only while omega_contact dt < sqrt(6)";
+    o << "the iterative passes do not settle: the accelerations of the last two passes changed by "
+      << outcome.change_first << " and " << last << " times their size (|a| + |g|; particle "
+      << agreed_id(outcome.change_mine == last, outcome.change_id) << "), more than "
+      << IterativeIntegrator::kMaxUnsettledChange
+      << "; the passes converge only while omega_contact dt < sqrt(6)";
   }
   return o.str();
 }

@@ -313,12 +313,13 @@ inline constexpr Key<RunSpec> kRunKeys[] = {
      .type = Type::kChoice,
      .choices = kChoiceNames<kGuardModes>,
      .field = choice<&RunSpec::guards_warn, kGuardModes>(),
-     .doc = "what the run's guards do when one fires (an overlap past 0.25 of the smaller "
-            "radius, energy created beyond 5 % of what went through the system, iterative "
-            "passes that diverge): `\"stop\"` ends the run with exit 3; `\"warn\"` tells each "
-            "kind when it first fires and runs to the end, which then exits 3 all the same. A "
-            "non-finite state and a particle moving more than 0.25 of its radius in one step "
-            "always stop"},
+     .doc =
+         "what the run's guards do when one fires (an overlap past 0.25 of the smaller "
+         "radius, energy created beyond 5 % of what went through the system, iterative "
+         "passes that do not settle): `\"stop\"` ends the run with exit 3; `\"warn\"` tells each "
+         "kind when it first fires and runs to the end, which then exits 3 all the same. A "
+         "non-finite state and a particle moving more than 0.25 of its radius in one step "
+         "always stop"},
     {.name = "seed",
      .type = Type::kInteger,
      .range = kNonNegative,
