@@ -191,6 +191,7 @@ struct TangentialSpringHistory {
 struct HertzMindlin : TangentialSpringHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kHertzMindlin;
   static constexpr bool kTorqueArmIsReff = false;
+  static constexpr bool kStiffnessVanishes = true;  // at zero overlap (k ~ sqrt(delta))
   template <class V>
   struct Coeffs {
     V e_star{}, g_star{}, mu_s{};
@@ -247,6 +248,7 @@ struct HertzMindlin : TangentialSpringHistory {
 struct ThesisModel : NoHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kThesis;
   static constexpr bool kTorqueArmIsReff = true;
+  static constexpr bool kStiffnessVanishes = true;
   template <class V>
   struct Coeffs {
     V e_star{}, g_star{}, mu_s{}, zeta_n{}, zeta_t{};
@@ -293,6 +295,7 @@ struct ThesisModel : NoHistory {
 struct LinearModel : TangentialSpringHistory {
   static constexpr ContactModelKind kKind = ContactModelKind::kLinear;
   static constexpr bool kTorqueArmIsReff = false;
+  static constexpr bool kStiffnessVanishes = false;
   template <class V>
   struct Coeffs {
     V mu_s{};
