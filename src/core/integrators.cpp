@@ -205,19 +205,19 @@ StepOutcome IterativeIntegrator::step(StepStages& s) {
     s.contact_forces(dt_, /*owned_cleared=*/false);
     checksum = accelerations(p, gravity_);
     ++pass;
-    passes.change_first = passes.change_last;
-    passes.change_mine = largest_change(p, passes.change_id);
-    passes.change_last = s.domain().max(passes.change_mine);
-    converged = pass > 1 && passes.change_last <= tolerance_;
+    passes.shift_first = passes.shift_last;
+    const double change = s.domain().max(largest_change(p, passes.shift_mine, passes.shift_id));
+    passes.shift_last = s.domain().max(passes.shift_mine);
+    converged = pass > 1 && change <= tolerance_;
   }
-  // Not settled: passes that cycle mildly (an epsd branch, a friction direction or a light
-  // contact that flips between passes) leave accelerations that differ by less than their size,
-  // and the step is taken (counted). When the last two passes' accelerations differ by more than
-  // kMaxUnsettledChange times their size, no pass is a usable answer (a stiff contact on in one
-  // pass and off in the next, or passes that grow: dt too large for the fixed point,
-  // omega_contact dt > sqrt(6)), and the step is an error.
+  // Not settled: passes that cycle mildly (an epsd branch, a friction direction or a contact
+  // that flips between passes) leave end positions that differ by a tiny fraction of a radius,
+  // and the step is taken (counted). When one of the last two passes moved a particle's end
+  // position by more than kMaxUnsettledShift of its radius, no pass is a usable answer (a stiff
+  // contact on in one pass and off in the next, or passes that grow: dt too large for the fixed
+  // point, omega_contact dt > sqrt(6)), and the step is an error.
   passes.diverged = !converged && pass >= 2 &&
-                    std::max(passes.change_first, passes.change_last) > kMaxUnsettledChange;
+                    std::max(passes.shift_first, passes.shift_last) > kMaxUnsettledShift;
   const double booked_power = loss_power(p);
   predict(p);  // the final state from the last accelerations (p.acc holds a1 for the next step)
   if (!converged) ++passes_.unconverged_steps;
@@ -321,19 +321,26 @@ void IterativeIntegrator::predict(ParticleStore& p) const {
 // max |a^k - a^(k-1)| / (|a^k| + a_ref) over every DOF, angular accelerations in units of
 // a_ref / r (converged when it is at most the tolerance on every rank, T31), and its particle
 // (`id`). The latest accelerations become a1.
-double IterativeIntegrator::largest_change(const ParticleStore& p, std::int64_t& id) {
+double IterativeIntegrator::largest_change(const ParticleStore& p, double& shift,
+                                           std::int64_t& shift_id) {
   const double a_ref = std::max(norm(gravity_), 1e-12);
+  const double c2 = dt_ * dt_ / 6.0;  // x1 moves by dt^2 / 6 times a change of a1
   const std::size_t n = p.n_owned();
   double worst = 0.0;
+  shift = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
     const Vec2 a = p.acc[k];
-    const double ref_w = a_ref / p.radius[k];
-    const double c = std::max({std::abs(a.x - a1_[k].x) / (std::abs(a.x) + a_ref),
-                               std::abs(a.y - a1_[k].y) / (std::abs(a.y) + a_ref),
-                               std::abs(p.alpha[k] - al1_[k]) / (std::abs(p.alpha[k]) + ref_w)});
-    if (std::isnan(c) || c > worst) {  // a NaN change stays the largest
-      worst = c;
-      id = p.id[k];
+    const double r = p.radius[k], ref_w = a_ref / r;
+    const Vec2 da = a - a1_[k];
+    const double dal = p.alpha[k] - al1_[k];
+    const double c = std::max({std::abs(da.x) / (std::abs(a.x) + a_ref),
+                               std::abs(da.y) / (std::abs(a.y) + a_ref),
+                               std::abs(dal) / (std::abs(p.alpha[k]) + ref_w)});
+    worst = std::isnan(c) || c > worst ? c : worst;  // a NaN change stays the largest
+    const double moved = c2 * std::max(norm(da), std::abs(dal) * r) / r;
+    if (std::isnan(moved) || moved > shift) {
+      shift = moved;
+      shift_id = p.id[k];
     }
     a1_[k] = a;
     al1_[k] = p.alpha[k];

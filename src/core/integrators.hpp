@@ -90,14 +90,14 @@ struct StepOutcome {
   // iterative: the step just taken, |x1 - x0| / r) and the id of the particle making it.
   double motion = 0.0;
   std::int64_t motion_id = -1;
-  // Iterative: the passes did not settle and the last two changed the accelerations by more than
-  // IterativeIntegrator::kMaxUnsettledChange times their size, the same on every rank; the
-  // largest relative changes of the last two passes (IterativeIntegrator::largest_change) and
-  // this rank's particle of the last one.
+  // Iterative: the passes did not settle and the last two moved some particle's end position by
+  // more than IterativeIntegrator::kMaxUnsettledShift of its radius, the same on every rank; the
+  // largest such shifts of the last two passes (IterativeIntegrator::largest_change), this
+  // rank's largest of the last one and its particle.
   bool diverged = false;
-  double change_first = 0.0, change_last = 0.0;
-  double change_mine = 0.0;  // this rank's largest change of the last pass
-  std::int64_t change_id = -1;
+  double shift_first = 0.0, shift_last = 0.0;
+  double shift_mine = 0.0;
+  std::int64_t shift_id = -1;
 };
 
 // Passes of force evaluation per step (always 1 for Verlet).
@@ -198,15 +198,18 @@ class IterativeIntegrator final : public Integrator {
  public:
   IterativeIntegrator(double dt, Vec2 gravity, double tolerance, int max_passes)
       : dt_(dt), gravity_(gravity), tolerance_(tolerance), max_passes_(max_passes) {}
-  // Unsettled passes whose last two changes exceed this (relative to |a| + |g|) are an error.
-  static constexpr double kMaxUnsettledChange = 4.0;
+  // Unsettled passes that moved a particle's end position by more than this fraction of its
+  // radius (one of the last two passes) are an error.
+  static constexpr double kMaxUnsettledShift = 0.01;
   StepOutcome step(StepStages& s) override;
 
  private:
   bool rebuild_due(StepStages& s) const;
   void save_start(const ParticleStore& p);
   void predict(ParticleStore& p) const;
-  double largest_change(const ParticleStore& p, std::int64_t& id);
+  // This rank's largest relative change of the accelerations since the last pass, and (out) the
+  // largest shift of an end position it makes, in radii, with its particle.
+  double largest_change(const ParticleStore& p, double& shift, std::int64_t& shift_id);
   double loss_power(const ParticleStore& p) const;
   double late_loss(const ParticleStore& p, double booked_power) const;
   void largest_motion(const ParticleStore& p, StepOutcome& out) const;

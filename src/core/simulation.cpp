@@ -212,12 +212,12 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
       o << " and a wall";
   } else {
     kind = "passes";
-    const double last = outcome.change_last;
-    o << "the iterative passes do not settle: the accelerations of the last two passes changed by "
-      << outcome.change_first << " and " << last << " times their size (|a| + |g|; particle "
-      << agreed_id(outcome.change_mine == last, outcome.change_id) << "), more than "
-      << IterativeIntegrator::kMaxUnsettledChange
-      << "; the passes converge only while omega_contact dt < sqrt(6)";
+    const double last = outcome.shift_last;
+    o << "the iterative passes do not settle: the last two passes moved the end position of "
+      << "particle " << agreed_id(outcome.shift_mine == last, outcome.shift_id) << " by "
+      << outcome.shift_first << " and " << last << " of its radius (at most "
+      << IterativeIntegrator::kMaxUnsettledShift
+      << "); the passes converge only while omega_contact dt < sqrt(6)";
   }
   return o.str();
 }

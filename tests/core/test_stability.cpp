@@ -454,11 +454,10 @@ TEST(Stability, GuardsCanWarnAndTheRunGoesOn) {
 
 // The iterative scheme's passes are a fixed-point iteration that contracts only while
 // omega_contact dt < sqrt(6). A ball resting on a floor (omega_contact about 3600 rad/s) at
-// dt = 1 ms: the passes alternate between the ball deep in the floor and off it, the
-// accelerations of the last two passes differing by 1 and 20-110 times their size, and the step
-// is an error naming the step and the particle, where before it was taken unconverged and
-// counted.
-// At the safe dt every step converges.
+// dt = 1 ms: the passes cycle between the ball deeper in the floor and higher, their end positions
+// a few percent of a radius apart, and the run stops (exit 3) naming the step and the particle,
+// where before such steps were taken unconverged and counted. At the safe dt every step
+// converges.
 TEST(Stability, UnsettledIterativePassesAreAnError) {
   Scene s = base_scene(IntegratorKind::kIterative);
   s.materials[0] = thesis_steel(0.5);
@@ -481,6 +480,7 @@ TEST(Stability, UnsettledIterativePassesAreAnError) {
   }
   s.run.dt_auto = false;
   s.run.dt = 1.0e-3;
+  s.run.duration = 0.05;
   s.run.allow_unsafe_dt = true;
   Simulation sim(s);
   std::string what;
@@ -493,9 +493,9 @@ TEST(Stability, UnsettledIterativePassesAreAnError) {
   }
   std::cout << "[ passes ] " << what << "\n";
   EXPECT_GE(step, 1);
-  EXPECT_LE(step, 2) << "stopped at once, not taken and counted";
+  EXPECT_LT(step, 50) << "stopped, not taken and counted to the end";
   EXPECT_NE(what.find("the iterative passes do not settle"), std::string::npos) << what;
-  EXPECT_NE(what.find("particle 0)"), std::string::npos) << what;
+  EXPECT_NE(what.find("end position of particle 0 by"), std::string::npos) << what;
 }
 
 // Non-finite blow-up: two balls given the same centre (their contact normal is 0/0) among
