@@ -206,9 +206,11 @@ StepOutcome IterativeIntegrator::step(StepStages& s) {
     checksum = accelerations(p, gravity_);
     ++pass;
     passes.shift_first = passes.shift_last;
-    const double change = s.domain().max(largest_change(p, passes.shift_mine, passes.shift_id));
-    passes.shift_last = s.domain().max(passes.shift_mine);
-    converged = pass > 1 && change <= tolerance_;
+    double largest[2] = {largest_change(p, passes.shift_mine, passes.shift_id), 0.0};
+    largest[1] = passes.shift_mine;
+    s.domain().max(largest);  // one collective per pass: the change and the shift, every rank
+    passes.shift_last = largest[1];
+    converged = pass > 1 && largest[0] <= tolerance_;
   }
   // Not settled: passes that cycle mildly (an epsd branch, a friction direction or a contact
   // that flips between passes) leave end positions that differ by a tiny fraction of a radius,
