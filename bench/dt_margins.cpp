@@ -38,20 +38,14 @@
 #include <vector>
 
 #include "core/simulation.hpp"
+#include "settled_drum.hpp"
 
 namespace dem2d {
 namespace {
 
 MaterialSpec steel(double restitution) {
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;
+  MaterialSpec m = bench::steel();  // thesis Table 1
   m.restitution = restitution;
-  m.sliding_friction = 0.1;
-  m.rolling_friction = 0.05;
   return m;
 }
 

@@ -22,6 +22,7 @@
 
 #include "core/simulation.hpp"
 #include "core/time_scales.hpp"
+#include "settled_drum.hpp"
 
 namespace dem2d {
 namespace {
@@ -31,14 +32,8 @@ constexpr double kRadius = 0.1, kSpeed = 20.0;
 Scene impact(double e, IntegratorKind integrator, double dt, double gap) {
   Scene s;
   s.deck_path = "steps_per_contact";
-  MaterialSpec m;
-  m.name = "steel";
-  m.density = 7800.0;
-  m.youngs_modulus = 2.0e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8.0e10;
+  MaterialSpec m = bench::steel();  // thesis Table 1
   m.restitution = e;
-  m.sliding_friction = 0.1;
   m.rolling_friction = 0.0;
   s.materials = {m};
   s.run.gravity = {0.0, 0.0};

@@ -155,14 +155,12 @@ void Simulation::refresh_forces() {
 // few more collectives, only now) and throws, or records it (run.guards = "warn").
 void Simulation::report_unstable(const StepOutcome& outcome) {
   const bool finite = !domain_->any(!std::isfinite(outcome.checksum));
-  std::string kind;
+  Guard guard = Guard::kFinite;
   std::ostringstream o;
   o << "the run became unstable at step " << step_ << " (t = " << time_
-    << " s): " << unstable_reason(outcome, finite, kind) << "; dt = " << dt_
+    << " s): " << unstable_reason(outcome, finite, guard) << "; dt = " << dt_
     << " s, the safe dt is " << scales_.safe_dt << " s";
-  // Past the motion guard neither the contact search nor the decomposition's halo hold: it
-  // always stops, like a non-finite state.
-  if (finite && kind != "motion" && scene_.run.guards_warn) return guard_fired(kind, o.str());
+  if (guard_may_warn(guard) && scene_.run.guards_warn) return guard_fired(guard, o.str());
   const std::int64_t failed_step = step_;
   const double failed_time = time_;
   if (!finite) {
@@ -172,8 +170,7 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
   throw UnstableError(o.str(), failed_step, failed_time);
 }
 
-std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
-                                        std::string& kind) {
+std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite, Guard& guard) {
   const EvaluationTotals& totals = contacts_.totals();
   const double max_overlap = domain_->max(totals.max_overlap);
   // The particle named alike on every rank (ids are below 2^53): the one on the rank whose
@@ -183,7 +180,7 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
   };
   std::ostringstream o;
   if (!finite) {
-    kind = "finite";
+    guard = Guard::kFinite;
     o << "non-finite positions or accelerations";
     // interface.md (exit 3) asks for the particle ids: name this rank's first few.
     int named = 0;
@@ -196,12 +193,12 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
       o << (named++ ? ", particle " : " of particle ") << p.id[k];
     }
   } else if (const double motion = domain_->max(outcome.motion); motion > kMaxStepMotion) {
-    kind = "motion";
+    guard = Guard::kMotion;
     o << "particle " << agreed_id(outcome.motion == motion, outcome.motion_id) << " moves "
       << motion << " times its radius in one step (at most " << kMaxStepMotion
       << "): bodies could pass through each other";
   } else if (max_overlap > kMaxOverlapRatio) {
-    kind = "overlap";
+    guard = Guard::kOverlap;
     const bool mine = totals.max_overlap == max_overlap;
     const std::int64_t worst_b = agreed_id(mine, totals.worst_b);
     o << "overlap " << max_overlap << " of a radius between particle "
@@ -211,7 +208,7 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
     else
       o << " and a wall";
   } else {
-    kind = "passes";
+    guard = Guard::kPasses;
     const double last = outcome.shift_last;
     o << "the iterative passes do not settle: the last two passes moved the end position of "
       << "particle " << agreed_id(outcome.shift_mine == last, outcome.shift_id) << " by "
@@ -222,7 +219,8 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
   return o.str();
 }
 
-void Simulation::guard_fired(const std::string& kind, const std::string& message) {
+void Simulation::guard_fired(Guard guard, const std::string& message) {
+  const std::string kind = guard_name(guard);
   for (GuardRecord& g : guards_)
     if (g.kind == kind) {
       ++g.count;
@@ -246,7 +244,7 @@ void Simulation::check_energy() {
     << " of the " << through << " J that went through the system (at most "
     << kEnergyCreatedTolerance << "); dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt
     << " s";
-  if (scene_.run.guards_warn && std::isfinite(created)) return guard_fired("energy", o.str());
+  if (scene_.run.guards_warn && std::isfinite(created)) return guard_fired(Guard::kEnergy, o.str());
   throw UnstableError(o.str(), step_, time_);
 }
 

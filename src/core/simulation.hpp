@@ -55,9 +55,19 @@ inline constexpr double kEnergyCreatedTolerance = 0.05;
 // The balance is checked every this many steps and at the deck's last step.
 inline constexpr std::int64_t kEnergyCheckSteps = 1000;
 
+// The run's guards. A non-finite state and the motion guard always stop the run: past them
+// neither the contact search nor the decomposition's halo hold. The others may warn instead
+// (run.guards = "warn").
+enum class Guard { kFinite, kMotion, kOverlap, kEnergy, kPasses };
+constexpr const char* guard_name(Guard g) {
+  constexpr const char* kNames[] = {"finite", "motion", "overlap", "energy", "passes"};
+  return kNames[static_cast<int>(g)];
+}
+constexpr bool guard_may_warn(Guard g) { return g != Guard::kFinite && g != Guard::kMotion; }
+
 // A guard that fired in a run with run.guards = "warn" (the run went on).
 struct GuardRecord {
-  std::string kind;        // "overlap", "motion", "energy" or "passes"
+  std::string kind;        // guard_name: "overlap", "energy" or "passes"
   std::int64_t count = 0;  // steps (energy: checks, every kEnergyCheckSteps) at which it fired
   std::string first;       // the message of the first time, as the stopping error would say it
 };
@@ -118,8 +128,8 @@ class Simulation final : private StepStages {
   // A guard fired (collective: every rank builds the same message). Throws UnstableError,
   // unless run.guards = "warn" and the state is finite: then it is recorded and the run goes on.
   void report_unstable(const StepOutcome& outcome);
-  std::string unstable_reason(const StepOutcome& outcome, bool finite, std::string& kind);
-  void guard_fired(const std::string& kind, const std::string& message);
+  std::string unstable_reason(const StepOutcome& outcome, bool finite, Guard& guard);
+  void guard_fired(Guard guard, const std::string& message);
   // The energy guard: energy created beyond kEnergyCreatedTolerance (collective).
   void check_energy();
   void take_energy_baseline();

@@ -16,6 +16,7 @@
 namespace dem2d {
 namespace {
 
+using testing_support::energy_balance;
 using testing_support::thesis_steel;
 
 ParticleSpec ball(double r, Vec2 x, Vec2 v = {}) {
@@ -151,15 +152,11 @@ PileResult pile(double e, IntegratorKind integrator) {
   s.fills = {testing_support::box_fill("steel", 60, 0.04, 0.06, {-0.55, 0.3}, {0.55, 1.4})};
   s.run.duration = 1.5;
   Simulation sim(s);
-  const auto balance = [](const SeriesRow& r) {
-    return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
-           r.dissipated_energy - r.drive_work;
-  };
-  const double b0 = balance(sim.diagnostics());
+  const double b0 = energy_balance(sim.diagnostics());
   sim.run_until(1.5);
   const SeriesRow r = sim.diagnostics();
   PileResult out;
-  out.residual = (balance(r) - b0) / r.dissipated_energy;
+  out.residual = (energy_balance(r) - b0) / r.dissipated_energy;
   out.max_speed = max_speed(sim.particles());
   const ParticleStore& p = sim.particles();
   for (std::size_t k = 0; k < p.n_owned(); ++k)
@@ -182,6 +179,23 @@ TEST(HardCases, PilesAtLowAndHighRestitutionSettleInTheBox) {
   }
 }
 
+// A drum scene run to t_end: the largest overlap of any step (of the smaller radius) and the
+// balance residual over the drive work.
+struct DrumRun {
+  double max_overlap = 0.0, residual = 0.0;
+};
+DrumRun run_drum(Simulation& sim, double t_end) {
+  const double b0 = energy_balance(sim.diagnostics());
+  DrumRun out;
+  while (sim.time() + 0.5 * sim.dt() < t_end) {
+    sim.step();
+    out.max_overlap = std::max(out.max_overlap, sim.last_totals().max_overlap);
+  }
+  const SeriesRow r = sim.diagnostics();
+  out.residual = (energy_balance(r) - b0) / r.drive_work;
+  return out;
+}
+
 // 20 000 steel balls (r = 1 cm) filled into the bottom of the thesis drum (16 sides) when it is
 // switched on at 10 rad/s (ramp 10 ms): the shell's corners sweep into the bed at up to 25 m/s.
 // At dt = "auto" (which allows for closing at twice the rim speed) nothing is lost and nothing
@@ -192,22 +206,12 @@ TEST(HardCases, TwentyThousandBallsAtTenRadiansPerSecondFromRest) {
   Scene s = testing_support::thesis_drum_scene(20000, 10.0, 16, 0.01);
   s.fills[0].radius_min = s.fills[0].radius_max = 0.01;
   Simulation sim(s);
-  const SeriesRow r0 = sim.diagnostics();
-  double max_overlap = 0.0;
-  while (sim.time() + 0.5 * sim.dt() < 0.1) {
-    sim.step();
-    max_overlap = std::max(max_overlap, sim.last_totals().max_overlap);
-  }
+  const auto [max_overlap, residual] = run_drum(sim, 0.1);
   const SeriesRow r = sim.diagnostics();
-  const auto balance = [](const SeriesRow& x) {
-    return x.kinetic_energy + x.rotational_energy + x.potential_energy + x.elastic_energy +
-           x.dissipated_energy - x.drive_work;
-  };
   const ParticleStore& p = sim.particles();
   // The polygon's inscribed radius is 2.5 cos(pi / 16); a ball centre is at least r inside it.
   double farthest = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) farthest = std::max(farthest, norm(p.pos[k]));
-  const double residual = (balance(r) - balance(r0)) / r.drive_work;
   std::cout << "[ hard ] 20 000 balls, 10 rad/s from rest: dt " << sim.dt() << " s, "
             << sim.step_count() << " steps, max overlap " << max_overlap << " r, farthest centre "
             << farthest << " m, drive work " << r.drive_work << " J, balance residual " << residual
@@ -229,17 +233,8 @@ TEST(HardCases, TenToOneSizeRangeInTheDrum) {
   s.fills[0].radius_min = 0.01;
   s.fills[0].radius_max = 0.1;
   Simulation sim(s);
-  const SeriesRow r0 = sim.diagnostics();
-  double max_overlap = 0.0;
-  while (sim.time() + 0.5 * sim.dt() < 2.0) {
-    sim.step();
-    max_overlap = std::max(max_overlap, sim.last_totals().max_overlap);
-  }
+  const auto [max_overlap, residual] = run_drum(sim, 2.0);
   const SeriesRow r = sim.diagnostics();
-  const auto balance = [](const SeriesRow& x) {
-    return x.kinetic_energy + x.rotational_energy + x.potential_energy + x.elastic_energy +
-           x.dissipated_energy - x.drive_work;
-  };
   const ParticleStore& p = sim.particles();
   double farthest = 0.0, r_min = 1.0, r_max = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
@@ -247,7 +242,6 @@ TEST(HardCases, TenToOneSizeRangeInTheDrum) {
     r_min = std::min(r_min, p.radius[k]);
     r_max = std::max(r_max, p.radius[k]);
   }
-  const double residual = (balance(r) - balance(r0)) / r.drive_work;
   std::cout << "[ hard ] size range " << r_max / r_min << ":1 (" << r_min << "-" << r_max
             << " m), 400 balls at 1.8 rad/s: dt " << sim.dt() << " s, max overlap " << max_overlap
             << " of the smaller radius, farthest reach " << farthest << " m, balance residual "

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "core/diagnostics.hpp"
 #include "core/scene.hpp"
 
 namespace dem2d::testing_support {
@@ -42,6 +43,13 @@ inline Scene thesis_drum_scene(int balls, double speed, int sides, double ramp_t
   f.region = FillRegion::kBottom;
   s.fills.push_back(f);
   return s;
+}
+
+// The energy balance of a series row: kinetic + rotational + potential + elastic + dissipated
+// - drive work, constant up to the integrator's error.
+inline double energy_balance(const SeriesRow& r) {
+  return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
+         r.dissipated_energy - r.drive_work;
 }
 
 // An open box of three `material` wall segments: the floor from (-half_width, 0) to
