@@ -11,7 +11,8 @@
 //               Verlet run at dt_auto / 16, a short time after the first contact (--horizon,
 //               default 0.05 s; the charge falls from its fill first), before the runs part by
 //               chaos, on the common time grid; in ball radii, RMS over every seed;
-//   ledger      (seed 1) (kinetic + rotational + potential + elastic + dissipated - drive work) at 1 s
+//   ledger      (seed 1) (kinetic + rotational + potential + elastic + dissipated - drive work) at
+//   1 s
 //               minus at the start, over the drive work (the energy balance's residual);
 //   collisions  the collision energies breakage models read: every contact that ends gives its
 //               peak normal strain energy (the peak-energy tracker slot).
@@ -20,10 +21,12 @@
 //               the matched ones, and sum |E - E_ref| / sum E_ref over the union (a contact in
 //               one run only counts in full, so a rattle that splits one touch in two shows).
 //               These converge with dt while the trajectories do.
-//               1 s (seed 1 only): the largest relative difference of the 50th, 90th and 99th percentiles of
-//               every contact ending within 1 s, against the reference's: a statistic of runs
-//               that have parted by chaos, so it measures their spread, not the step;
-//   work        (seed 1) force evaluations (steps x passes) and seconds spent stepping (wall time on one
+//               1 s (seed 1 only): the largest relative difference of the 50th, 90th and 99th
+//               percentiles of every contact ending within 1 s, against the reference's: a
+//               statistic of runs that have parted by chaos, so it measures their spread, not the
+//               step;
+//   work        (seed 1) force evaluations (steps x passes) and seconds spent stepping (wall time
+//   on one
 //               core, the collision log excluded) per simulated second.
 // The trajectory error against work is the speed-against-error a user pays for; the ratio per
 // halving of dt shows the order. Output: the table on stdout, bench/results/many_body_error.csv,
@@ -242,7 +245,8 @@ int main(int argc, char** argv) {
   const std::string csv_path = results + "/many_body_error.csv";
   std::ofstream csv(csv_path);
   csv << "scene,integrator,dt,dt_over_auto,is_auto,trajectory_error_radii,ledger_residual,"
-         "early_collision_error,early_collisions,early_collision_median,spectrum_error,collisions,evaluations_per_s,"
+         "early_collision_error,early_collisions,early_collision_median,spectrum_error,collisions,"
+         "evaluations_per_s,"
          "step_seconds_per_s\n";
   std::printf("%-13s %-10s %10s %8s %12s %6s %11s %9s %6s %6s %9s %9s %6s %10s %8s\n", "scene",
               "integrator", "dt_s", "dt/auto", "traj_err_r", "order", "ledger_res", "early_E",
@@ -306,16 +310,16 @@ int main(int argc, char** argv) {
         const bool is_auto = f == 1.0;
         const double spectrum = spectrum_error(r.collisions, ref_first.collisions);
         std::printf(
-            "%-13s %-10s %10.4g %8.3g %12.4g %6s %11.3g %9.3g %6s %6zu %9.3g %9.3g %6zu %10.4g %8.4g%s\n",
+            "%-13s %-10s %10.4g %8.3g %12.4g %6s %11.3g %9.3g %6s %6zu %9.3g %9.3g %6zu %10.4g "
+            "%8.4g%s\n",
             name.c_str(), iname, dt, f, err, order.c_str(), r.residual, early, early_order.c_str(),
             e.relative.size(), e.median(), spectrum, r.collisions.size(), r.evaluations, r.cpu,
             is_auto ? "  <- dt = \"auto\"" : "");
         std::fflush(stdout);
         csv << name << "," << iname << "," << dt << "," << f << "," << (is_auto ? 1 : 0) << ","
             << err << "," << r.residual << "," << early << "," << e.relative.size() << ","
-            << e.median() << ","
-            << spectrum << "," << r.collisions.size() << "," << r.evaluations << "," << r.cpu
-            << "\n";
+            << e.median() << "," << spectrum << "," << r.collisions.size() << "," << r.evaluations
+            << "," << r.cpu << "\n";
       }
     }
   }
