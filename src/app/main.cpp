@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +21,7 @@
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
 #include "io/deck.hpp"
+#include "io/ore_logs.hpp"
 #include "io/output_dir.hpp"
 #include "io/run_json.hpp"
 #include "io/series.hpp"
@@ -173,7 +175,7 @@ class SeriesOutput {
     try {
       file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/series.csv",
                                              scene.run.integrator == IntegratorKind::kIterative,
-                                             g_rank == 0);
+                                             g_rank == 0, is_ore_scene(scene));
     } catch (const IoError& e) {
       error = e.what();
     }
@@ -193,11 +195,72 @@ class SeriesOutput {
   std::unique_ptr<SeriesWriter> file_;
 };
 
+// product.csv and breakages.csv of ore scenes: every rank's records since the last row are
+// gathered (as 64-bit words) and rank 0 appends them; a write failure stops every rank alike.
+class OreOutput {
+ public:
+  explicit OreOutput(const Scene& scene) {
+    if (!is_ore_scene(scene)) return;
+    std::string error;
+    try {
+      logs_ = std::make_unique<OreLogs>(scene.output.directory, g_rank == 0);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+  }
+  void write(Simulation& sim) {
+    if (!logs_) return;
+    std::vector<std::int64_t> words;
+    const auto put = [&words](auto x) {
+      if constexpr (std::is_same_v<decltype(x), double>)
+        words.push_back(std::bit_cast<std::int64_t>(x));
+      else
+        words.push_back(static_cast<std::int64_t>(x));
+    };
+    const std::vector<BreakageRecord> mine_b = sim.grinding()->take_breakages();
+    const std::vector<ProductRecord> mine_p = sim.grinding()->take_product();
+    put(mine_b.size());
+    for (const BreakageRecord& r : mine_b) {
+      put(r.time), put(r.parent), put(r.radius), put(r.energy), put(r.fragments), put(r.first_id);
+    }
+    for (const ProductRecord& r : mine_p) put(r.time), put(r.id), put(r.radius), put(r.mass);
+    put(mine_p.size());  // last: the reader walks each rank's block from both ends
+    words.insert(words.begin(), static_cast<std::int64_t>(words.size()) + 1);
+    const std::vector<std::int64_t> all = mpi::all_gather(MPI_COMM_WORLD, words);
+    std::vector<BreakageRecord> breakages;
+    std::vector<ProductRecord> product;
+    const auto real = [](std::int64_t w) { return std::bit_cast<double>(w); };
+    for (std::size_t at = 0; at < all.size(); at += static_cast<std::size_t>(all[at])) {
+      const std::int64_t* w = &all[at + 1];
+      const std::int64_t nb = *w++;
+      for (std::int64_t k = 0; k < nb; ++k, w += 6)
+        breakages.push_back(
+            {real(w[0]), w[1], real(w[2]), real(w[3]), static_cast<int>(w[4]), w[5]});
+      const std::size_t end = at + static_cast<std::size_t>(all[at]);
+      const std::int64_t np = all[end - 1];
+      for (std::int64_t k = 0; k < np; ++k, w += 4)
+        product.push_back({real(w[0]), w[1], real(w[2]), real(w[3])});
+    }
+    std::string error;
+    try {
+      logs_->write(std::move(breakages), std::move(product));
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+  }
+
+ private:
+  std::unique_ptr<OreLogs> logs_;
+};
+
 // The time loop with its outputs: series rows and snapshots at their intervals, the first and
 // last state always. Returns false when the run became unstable, after writing a last
 // snapshot and reporting it.
 bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, SnapshotWriter& snapshots,
              Progress& progress, std::int64_t n_global) {
+  OreOutput ore(scene);
   const OutputSpec& out = scene.output;
   const double dt = sim.dt();
   const auto at_multiple = [dt](double t, double interval) {
@@ -223,12 +286,14 @@ bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, Snapshot
             stderr);
       if (at_multiple(sim.time(), out.series_interval)) {
         series.write(sim.diagnostics());
+        ore.write(sim);
         sim.reset_pass_window();
       }
       if (at_multiple(sim.time(), out.snapshot_interval)) snapshot();
       progress.update(sim, n_global);
     }
   } catch (const UnstableError& e) {
+    ore.write(sim);
     snapshots.write(sim.particles(), sim.time(), sim.step_count());
     say(scene.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
             "/snapshots.h5\n",
@@ -237,6 +302,7 @@ bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, Snapshot
   }
   if (last_snapshot_time != sim.time()) snapshot();
   if (!at_multiple(sim.time(), out.series_interval)) series.write(sim.diagnostics());
+  ore.write(sim);
   progress.update(sim, n_global, true);
   return true;
 }

@@ -20,7 +20,7 @@
 namespace dem2d {
 
 // Most history slots a contact model may declare (law + rolling + tracker + stepper).
-inline constexpr std::size_t kMaxHistorySlots = 8;
+inline constexpr std::size_t kMaxHistorySlots = 10;
 
 // The history columns of a batch: slot s of contact c is old[s][c] before the step, fresh[s][c]
 // after it.

@@ -1,6 +1,8 @@
 #include "core/contact_engine.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <tuple>
 #include <type_traits>
 
@@ -115,6 +117,13 @@ std::vector<double> ContactEngine::particle_work(std::size_t n_owned) const {
     if (j < n_owned) work[j] += both ? 0.5 : 1.0;
   }
   return work;
+}
+
+std::size_t ContactEngine::history_offset(std::string_view name) const {
+  const auto slots = history_slots();
+  for (std::size_t k = 0; k < slots.size(); ++k)
+    if (slots[k].name == name) return k;
+  throw std::logic_error("the contact model has no history slot " + std::string(name));
 }
 
 }  // namespace dem2d

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "core/contact_history.hpp"
@@ -87,6 +88,13 @@ class ContactEngine {
 
   const PairList& pairs() const { return pairs_; }
   const WallPairList& wall_pairs() const { return wall_pairs_; }
+  // The lists with their committed histories, for the models that write a tracker slot between
+  // steps (breakage: the level tested, the birth exclusions; core/grinding.cpp).
+  PairList& mutable_pairs() { return pairs_; }
+  WallPairList& mutable_wall_pairs() { return wall_pairs_; }
+  // Where the slot named `name` sits in a contact's history (throws std::logic_error if the
+  // model has none).
+  std::size_t history_offset(std::string_view name) const;
   std::int64_t builds() const { return search_.builds(); }
 
  private:

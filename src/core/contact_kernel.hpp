@@ -359,7 +359,9 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
       diss += out.rolling.dissipated;
       el += out.rolling.elastic;
     }
-    const Pack ratio = kin.delta / vmin(ri, rj);
+    Pack ratio = kin.delta / vmin(ri, rj);
+    if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
+      ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
     // Padding lanes repeat the last contact: keep them out of the sums.
     const PackMask real =
         Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
@@ -484,6 +486,8 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     store(out.rolling.elastic, wb_.el_roll, c);
     store(-cf.f_el * nx, wb_.ex, c);
     store(-cf.f_el * ny, wb_.ey, c);
+    if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
+      store(kin.delta - out.birth_overlap, wb_.delta, c);
   }
 }
 
@@ -561,6 +565,8 @@ std::unique_ptr<ContactKernel> make_law_kernel(const ContactSpec& spec, const Pa
                                                IntegratorKind integrator) {
   return pick<RollingModels>(rolling_kind, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
     using Rolling = typename decltype(rolling)::type;
+    if (spec.track_breakage)
+      return make_kernel<Law, Rolling, TrackBreakage>(spec, table, integrator);
     if (spec.track_peak_energy)
       return make_kernel<Law, Rolling, TrackPeakEnergy>(spec, table, integrator);
     return make_kernel<Law, Rolling, TrackNone>(spec, table, integrator);

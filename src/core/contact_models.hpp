@@ -471,6 +471,7 @@ using RollingModels = std::tuple<RollingNone, RollingConstant, RollingEpsd>;
 // Trackers: what a contact records for models outside the force law.
 
 struct TrackNone : NoHistory {
+  static constexpr bool kExcludes = false;
   template <class T>
   [[gnu::always_inline]] static void evaluate(const ContactForceT<T>&, const History<T>&,
                                               History<T>&) {}
@@ -479,6 +480,7 @@ struct TrackNone : NoHistory {
 // The largest strain energy of the contact so far (the breakage test reads it at the peak or
 // end of the contact, physics.md section 5).
 struct TrackPeakEnergy {
+  static constexpr bool kExcludes = false;
   static constexpr std::array<HistorySlot, 1> kHistory{
       {{"peak_energy", "J", "largest normal strain energy of the contact so far"}}};
   template <class T>
@@ -487,6 +489,33 @@ struct TrackPeakEnergy {
   [[gnu::always_inline]] static void evaluate(const ContactForceT<T>& cf, const History<T>& old,
                                               History<T>& h) {
     h[0] = vmax(old[0], cf.strain);
+  }
+};
+
+// Breakage (physics.md section 5): the peak strain energy, the energy at the end of the step
+// (the test runs when it has fallen below the peak: core/grinding.cpp), the peak level already
+// tested, and the birth overlap: bodies that overlapped when one of them was born (a fragment
+// inside its parent's circle) must not repel explosively (thesis), nor pass through each other.
+// The contact acts on the overlap beyond the one at birth, delta - delta_0, and delta_0 follows
+// the overlap down as the bodies separate, to 0 when they part (then the kernel clears the
+// history as for every contact that ends). A contact born marked (delta_0 < 0,
+// Grinding::exclude_births) takes its overlap at the first evaluation, the birth state.
+struct TrackBreakage {
+  static constexpr bool kExcludes = true;
+  static constexpr std::size_t kPeak = 0, kEnergy = 1, kTested = 2, kBirthOverlap = 3;
+  static constexpr std::array<HistorySlot, 4> kHistory{
+      {{"peak_energy", "J", "largest normal strain energy of the contact so far"},
+       {"energy", "J", "normal strain energy at the end of the last step"},
+       {"tested", "J", "the peak energy already tested for breakage"},
+       {"birth_overlap", "m", "overlap at a birth, ignored; follows the overlap down to 0"}}};
+  template <class T>
+  using History = HistoryArray<T, kHistory.size()>;
+  template <class T>
+  [[gnu::always_inline]] static void evaluate(const ContactForceT<T>& cf, const History<T>& old,
+                                              History<T>& h) {
+    h[kPeak] = vmax(old[kPeak], cf.strain);
+    h[kEnergy] = cf.strain;
+    h[kTested] = old[kTested];
   }
 };
 
@@ -543,6 +572,7 @@ template <class T>
 struct ContactResponseT {
   ContactForceT<T> law;
   RollingTorqueT<T> rolling;
+  T birth_overlap = T(0.0);  // m of the overlap ignored (trackers with kExcludes only)
 };
 
 template <class LawT, class RollingT, class TrackerT, class StepperT = StepAsSeen>
@@ -607,12 +637,46 @@ struct ContactModel {
                                                              const History<T>& old, History<T>& h,
                                                              double dt) {
     ContactResponseT<T> out;
+    if constexpr (Tracker::kExcludes) {
+      // The overlap at birth is ignored (TrackBreakage); it follows the overlap down.
+      const T marked = old.tracker[Tracker::kBirthOverlap];
+      const T d0 = vmin(select(marked < 0.0, kin.delta, marked), kin.delta);
+      const auto beyond = kin.delta - d0 > 0.0;
+      kin.delta = select(beyond, kin.delta - d0, T(1e-300));
+      respond_all(c, kin, old, h, dt, out);
+      if (any_of(!beyond)) mask(!beyond, out, h);
+      out.birth_overlap = d0;
+      h.tracker[Tracker::kBirthOverlap] = d0;
+    } else {
+      respond_all(c, kin, old, h, dt, out);
+    }
+    return out;
+  }
+
+  template <class T, class C>
+  [[gnu::always_inline]] static void respond_all(const C& c, KinematicsT<T>& kin,
+                                                 const History<T>& old, History<T>& h, double dt,
+                                                 ContactResponseT<T>& out) {
     Stepper::prepare(kin, old.stepper, h.stepper);
     out.law = Law::evaluate(c.law, kin, old.law, h.law, dt);
     if constexpr (Rolling::kActive)
       out.rolling = Rolling::evaluate(c.rolling, kin, out.law, old.rolling, h.rolling, dt);
     Tracker::evaluate(out.law, old.tracker, h.tracker);
-    return out;
+  }
+
+  // A contact not compressed beyond its birth overlap: no force, no energy, no spring history.
+  template <class T, class M>
+  [[gnu::always_inline]] static void mask(const M& off, ContactResponseT<T>& out, History<T>& h) {
+    const T zero(0.0);
+    ContactForceT<T>& f = out.law;
+    for (T* x : {&f.f_n, &f.f_t, &f.k_n, &f.dissipated, &f.elastic, &f.strain, &f.f_el})
+      *x = select(off, zero, *x);
+    RollingTorqueT<T>& r = out.rolling;
+    for (T* x : {&r.torque, &r.dissipated, &r.elastic}) *x = select(off, zero, *x);
+    for (T& x : h.law) x = select(off, zero, x);
+    for (T& x : h.rolling) x = select(off, zero, x);
+    for (T& x : h.stepper) x = select(off, zero, x);
+    h.tracker[Tracker::kEnergy] = select(off, zero, h.tracker[Tracker::kEnergy]);
   }
 };
 

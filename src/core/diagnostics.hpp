@@ -1,6 +1,7 @@
 // SeriesRow: one row of series.csv, the run's global diagnostics at one time.
 // Energies in J, torque in N m, power in W (docs/output.md). Energy balance:
-// kinetic + rotational + potential + elastic + dissipated - drive_work is constant.
+// kinetic + rotational + potential + elastic + dissipated - drive_work - fed_energy +
+// discharged_energy is constant (energy_balance below).
 #pragma once
 
 #include <cstdint>
@@ -21,6 +22,19 @@ struct SeriesRow {
   double drum_power = 0.0;         // drum_torque * drum speed
   double drive_work = 0.0;         // cumulative work done by the drive (and moving walls)
   double passes = 0.0;             // iterative integrator: mean passes per step since last row
+  // Ore scenes ([breakage], [feed], [sieve]): counts and masses since the start.
+  std::int64_t breakages = 0, fragments = 0, fed_count = 0, discharged_count = 0;
+  double fed_mass = 0.0, discharged_mass = 0.0;  // kg
+  double mill_mass = 0.0;                        // kg of every particle in the mill
+  double ore_mass = 0.0;                         // kg of the ore (breakage/feed/sieve material)
+  double fed_energy = 0.0;         // J the fed particles brought (kinetic + potential)
+  double discharged_energy = 0.0;  // J the discharged ones took (kinetic + rotational + potential)
 };
+
+// The energy balance: constant up to the integrator's error.
+inline double energy_balance(const SeriesRow& r) {
+  return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
+         r.dissipated_energy - r.drive_work - r.fed_energy + r.discharged_energy;
+}
 
 }  // namespace dem2d

@@ -43,6 +43,15 @@ class Domain {
   virtual bool any(bool x) const { return x; }
   // Element-wise maximum over ranks, in place (several decisions in one reduction).
   virtual void max(std::span<double> /*values*/) const {}
+  // Every rank's values, rank 0's first (population changes: the parents broken in a step).
+  virtual std::vector<std::int64_t> allgather(std::span<const std::int64_t> mine) const {
+    return {mine.begin(), mine.end()};
+  }
+  // Whether a point lies in this rank's region (where a fed particle is born).
+  virtual bool owns(Vec2 /*x*/) const { return true; }
+  // The number of particles over all ranks changed (breakage, feed, sieve): the next
+  // migrate() checks its count against `total`.
+  virtual void population_changed(std::int64_t /*total*/) {}
 
   // Every rank holds the same full set of owned particles (the fill is deterministic): keep
   // those in this rank's region, drop the rest. halo_width: how far from its region a rank

@@ -126,6 +126,9 @@ class Integrator {
   virtual StepOutcome step(StepStages& s) = 0;
   // After every rebuild (the owned set and the ghosts changed), in parallel runs.
   virtual void after_rebuild(std::size_t /*n_owned*/) {}
+  // After particles were born or removed between steps and the forces evaluated anew at the
+  // step's end state.
+  virtual void after_population_change() {}
   const PassCounter& passes() const { return passes_; }
   PassCounter& passes() { return passes_; }
 
@@ -164,6 +167,11 @@ class VelocityVerlet final : public Integrator {
   VelocityVerlet(double dt, Vec2 gravity) : dt_(dt), gravity_(gravity) {}
   StepOutcome step(StepStages& s) override;
   void after_rebuild(std::size_t n_owned) override;
+  // The new evaluation filled the elastic forces; the ghosts hold the current state.
+  void after_population_change() override {
+    elastic_cleared_ = false;
+    ghosts_ahead_ = false;
+  }
 
  private:
   struct Closing {

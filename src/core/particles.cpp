@@ -15,6 +15,14 @@ double ParticleStore::sphere_mass(double r, double density) {
   return 4.0 / 3.0 * std::numbers::pi * r * r * r * density;
 }
 
+void ParticleStore::enable_damage() {
+  if (damage_) return;
+  damage_ = std::make_unique<Field<double>>(
+      "damage", registry_,
+      FieldMeta{"J", "accumulated damage E_cum of a breakable particle (thesis T34)", true});
+  damage_->resize(size());
+}
+
 void ParticleStore::resize_all(std::size_t n) {
   for (FieldBase* f : registry_) f->resize(n);
 }

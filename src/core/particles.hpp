@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -138,6 +139,12 @@ class ParticleStore {
   // whole torque do work the energy ledger books as dissipated.
   Field<Vec2> elastic_force{"elastic_force", registry_, {"N", "elastic normal part of `force`"}};
 
+  // Fields a model registers only when a scene uses it (nullptr otherwise): a scene without the
+  // model moves no bytes for it. Enabled before the first particle is added.
+  Field<double>* damage() { return damage_.get(); }
+  const Field<double>* damage() const { return damage_.get(); }
+  void enable_damage();
+
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }
   std::size_t n_ghost() const { return size() - n_owned_; }
@@ -165,6 +172,7 @@ class ParticleStore {
  private:
   void resize_all(std::size_t n);
   std::size_t n_owned_ = 0;
+  std::unique_ptr<Field<double>> damage_;
 };
 
 }  // namespace dem2d

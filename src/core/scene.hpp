@@ -69,8 +69,11 @@ struct ContactSpec {
   RollingModelKind rolling = RollingModelKind::kEpsd;
   double rolling_damping = 0.3;  // epsd: eta_r, the rolling dashpot's damping ratio
   // Tracker slot: every contact records its peak strain energy (a history slot). Not a deck
-  // key: set by the models that read it (breakage, not yet built) and by tests.
+  // key: set by benchmarks and tests (breakage has its own tracker, chosen by [breakage]).
   bool track_peak_energy = false;
+  // The breakage tracker (peak energy, the energy now, the level tested, the birth exclusion);
+  // set by the core when the scene has a [breakage] table.
+  bool track_breakage = false;
 };
 
 struct LifterSpec {
@@ -126,6 +129,44 @@ struct WallSpec {
   Vec2 velocity{0.0, 0.0};  // a translating wall (moves rigidly)
 };
 
+// Ore breakage (physics.md section 5, thesis T34-T36): particles of one material break under the
+// peak strain energy of their contacts.
+struct BreakageSpec {
+  bool present = false;
+  std::string material;         // the material that breaks (ore)
+  double minimum_energy = 0.1;  // J, E_min: a contact below it does no damage (thesis Table 1)
+  double strength = 1.0;        // 1/J, S: P = 1 - exp(-S E_t) (thesis Table 1)
+  double fragments_mean = 4.0;  // fragment count: normal law, rounded and clipped
+  double fragments_sd = 2.0 / 3.0;
+  int fragments_min = 2;
+  int fragments_max = 6;
+  double minimum_radius = 0.0;  // m: particles smaller than this do not break
+};
+
+// Ore feed: one particle every `period` s (or as a mass rate), radius uniform in
+// [radius_min, radius_max], where the charge is thinnest or at `point`.
+struct FeedSpec {
+  bool present = false;
+  std::string material;
+  double period = 0.0;     // s between fed particles (0: use mass_rate)
+  double mass_rate = 0.0;  // kg/s (0: use period)
+  double radius_min = 0.0;
+  double radius_max = 0.0;
+  double start = 0.0;  // s: the first particle at this time
+  bool has_point = false;
+  Vec2 point{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};
+};
+
+// The sieve: ore whose centre is inside the box and whose radius is below the aperture leaves.
+struct SieveSpec {
+  bool present = false;
+  std::string material;      // the material it lets through (ore)
+  Vec2 box_min{-0.5, -0.5};  // thesis: 1 m x 1 m around the drum centre
+  Vec2 box_max{0.5, 0.5};
+  double aperture = 0.04;  // m, compared with the radius (physics.md section 5)
+};
+
 struct OutputSpec {
   std::string directory = "out";
   double series_interval = 1.0e-3;
@@ -150,8 +191,16 @@ struct Scene {
   std::vector<FillSpec> file_fills;
   std::vector<ParticleSpec> particles;
   std::vector<WallSpec> walls;
+  BreakageSpec breakage;
+  FeedSpec feed;
+  SieveSpec sieve;
   OutputSpec output;
 };
+
+// A scene with ore models ([breakage], [feed] or [sieve]).
+inline bool is_ore_scene(const Scene& s) {
+  return s.breakage.present || s.feed.present || s.sieve.present;
+}
 
 // Index of a material by name, or -1.
 int find_material(const Scene& scene, const std::string& name);

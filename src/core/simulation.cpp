@@ -12,6 +12,13 @@ namespace dem2d {
 
 namespace {
 
+// The scene as the core runs it: the models a table asks for switched on.
+Scene prepared(const Scene& scene) {
+  Scene s = scene;
+  s.contact.track_breakage = scene.breakage.present;
+  return s;
+}
+
 std::string format_seconds(double s) {
   std::ostringstream o;
   o.precision(3);
@@ -22,7 +29,11 @@ std::string format_seconds(double s) {
 }  // namespace
 
 Simulation::Simulation(const Scene& scene, Domain* domain)
-    : scene_(scene), domain_(domain ? domain : &serial_domain_), walls_(scene_), contacts_(scene_) {
+    : scene_(prepared(scene)),
+      domain_(domain ? domain : &serial_domain_),
+      walls_(scene_),
+      contacts_(scene_) {
+  if (scene_.breakage.present) particles_.enable_damage();
   place_particles(scene_, walls_, particles_);
   scales_ = time_scales(scene_, particles_);
   choose_dt();
@@ -37,6 +48,7 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
   // Every rank placed the same particles; from here on each keeps its own (parallel runs).
   // A pair interacts within r_i + r_j + skin, so a rank needs the particles within
   // 2 r_max + skin of its region.
+  if (scene_.feed.present) r_max = std::max(r_max, scene_.feed.radius_max);
   halo_width_ = 2.0 * r_max + rebuilds_.skin();
   ghost_fields_ = {&particles_.pos, &particles_.vel, &particles_.omega};
   domain_->adopt(particles_, halo_width_);
@@ -44,6 +56,8 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
   refresh_forces();
   backup_.save(particles_, time_, step_);
   builds_at_backup_ = contacts_.builds();
+  if (scene_.breakage.present || scene_.feed.present || scene_.sieve.present)
+    grinding_ = std::make_unique<Grinding>(scene_, particles_, *domain_);
 }
 
 // The energy balance as the first step starts (after whatever the caller set by hand), and
@@ -53,7 +67,7 @@ void Simulation::take_energy_baseline() {
   const SeriesRow r = diagnostics();
   motion0_ = r.kinetic_energy + r.rotational_energy + r.elastic_energy;
   potential0_ = r.potential_energy;
-  balance0_ = motion0_ + potential0_ + r.dissipated_energy - r.drive_work;
+  balance0_ = energy_balance(r);
   const double g = norm(scene_.run.gravity);
   double floor = 0.0;
   for (std::size_t k = 0; k < particles_.n_owned(); ++k)
@@ -87,11 +101,40 @@ void Simulation::step() {
   const StepOutcome outcome = integrator_->step(*this);
   ++step_;
   if (outcome.unstable) report_unstable(outcome);
+  if (grinding_) population_step();
   if (step_ % kEnergyCheckSteps == 0 || time_ + 0.5 * dt_ >= scene_.run.duration) check_energy();
   if (step_ % 1000 == 0 || builds_at_backup_ != contacts_.builds()) {
     backup_.save(particles_, time_, step_);
     builds_at_backup_ = contacts_.builds();
   }
+}
+
+void Simulation::population_step() {
+  const double before = local_energy();
+  const double fed = grinding_->fed_energy(), discharged = grinding_->discharged_energy();
+  if (!grinding_->after_step(time_, step_, particles_, contacts_, *domain_)) return;
+  domain_->population_changed(domain_->sum(static_cast<std::int64_t>(particles_.n_owned())));
+  rebuild();
+  grinding_->exclude_births(contacts_);
+  refresh_forces();
+  integrator_->after_population_change();
+  // Fragments keep the parents' mass and momentum and lose kinetic energy (their spin inertia
+  // is smaller); the springs of the parents' and the product's contacts and of contacts
+  // excluded at birth are gone: all of it is booked as dissipated, so the balance holds.
+  dissipated_ += before - local_energy() + (grinding_->fed_energy() - fed) -
+                 (grinding_->discharged_energy() - discharged);
+  backup_.save(particles_, time_, step_);
+  builds_at_backup_ = contacts_.builds();
+}
+
+double Simulation::local_energy() const {
+  const ParticleStore& p = particles_;
+  double e = contacts_.totals().elastic;
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    e += 0.5 * p.mass[k] *
+             (norm2(p.vel[k]) + 0.4 * p.radius[k] * p.radius[k] * p.omega[k] * p.omega[k]) -
+         p.mass[k] * dot(scene_.run.gravity, p.pos[k]);
+  return e;
 }
 
 void Simulation::run_until(double t_end) {
@@ -233,10 +276,10 @@ void Simulation::guard_fired(Guard guard, const std::string& message) {
 // up to the integrator's error. Grown beyond the tolerance, the run created energy.
 void Simulation::check_energy() {
   const SeriesRow r = diagnostics();
-  const double created = r.kinetic_energy + r.rotational_energy + r.potential_energy +
-                         r.elastic_energy + r.dissipated_energy - r.drive_work - balance0_;
-  const double through = energy_floor_ + motion0_ + std::abs(r.drive_work) +
-                         std::abs(r.dissipated_energy) + std::abs(r.potential_energy - potential0_);
+  const double created = energy_balance(r) - balance0_;
+  const double through =
+      energy_floor_ + motion0_ + std::abs(r.drive_work) + std::abs(r.dissipated_energy) +
+      std::abs(r.potential_energy - potential0_) + r.fed_energy + r.discharged_energy;
   if (!(created > kEnergyCreatedTolerance * through)) return;
   std::ostringstream o;
   o << "the run became unstable at step " << step_ << " (t = " << time_
@@ -275,7 +318,28 @@ SeriesRow Simulation::diagnostics() const {
   row.drum_power = row.drum_torque * walls_.drum_omega();
   row.drive_work = domain_->sum(drive_work_);
   row.passes = integrator_->passes().mean_since_row();
+  if (grinding_) grinding_row(row);
   return row;
+}
+
+void Simulation::grinding_row(SeriesRow& row) const {
+  const GrindingTotals& g = grinding_->totals();
+  row.breakages = g.breakages;
+  row.fragments = g.fragments;
+  row.fed_count = g.fed_count;
+  row.fed_mass = g.fed_mass;
+  row.discharged_count = g.discharged_count;
+  row.discharged_mass = g.discharged_mass;
+  const int ore = grinding_->ore_material();
+  double mill = 0.0, ore_mass = 0.0;
+  for (std::size_t k = 0; k < particles_.n_owned(); ++k) {
+    mill += particles_.mass[k];
+    if (particles_.material[k] == ore) ore_mass += particles_.mass[k];
+  }
+  row.mill_mass = domain_->sum(mill);
+  row.ore_mass = domain_->sum(ore_mass);
+  row.fed_energy = domain_->sum(grinding_->fed_energy());
+  row.discharged_energy = domain_->sum(grinding_->discharged_energy());
 }
 
 void Simulation::reset_pass_window() {

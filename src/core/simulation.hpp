@@ -22,6 +22,7 @@
 #include "core/contact_engine.hpp"
 #include "core/diagnostics.hpp"
 #include "core/domain.hpp"
+#include "core/grinding.hpp"
 #include "core/integrators.hpp"
 #include "core/materials.hpp"
 #include "core/neighbors.hpp"
@@ -106,6 +107,9 @@ class Simulation final : private StepStages {
   // The guards that fired (run.guards = "warn"), in the order they first fired; the same on
   // every rank.
   const std::vector<GuardRecord>& guard_records() const { return guards_; }
+  // Ore scenes ([breakage], [feed] or [sieve]): breakage, feed and sieve; nullptr otherwise.
+  Grinding* grinding() { return grinding_.get(); }
+  const Grinding* grinding() const { return grinding_.get(); }
 
   // Force a neighbour-list rebuild (after particles were moved or added by hand).
   void rebuild() override;
@@ -125,6 +129,13 @@ class Simulation final : private StepStages {
   void commit(double dt, double late_loss) override;
 
   void choose_dt();
+  // After a committed step of an ore scene: breakage, sieve and feed; when the population
+  // changed, the lists are rebuilt, births excluded, forces evaluated at the new state and the
+  // energy the change released booked as dissipated (collective).
+  void population_step();
+  void grinding_row(SeriesRow& row) const;
+  // This rank's kinetic, rotational, potential and elastic energy.
+  double local_energy() const;
   // A guard fired (collective: every rank builds the same message). Throws UnstableError,
   // unless run.guards = "warn" and the state is finite: then it is recorded and the run goes on.
   void report_unstable(const StepOutcome& outcome);
@@ -159,6 +170,7 @@ class Simulation final : private StepStages {
   StateBackup backup_;
   std::int64_t builds_at_backup_ = 0;
   std::vector<GuardRecord> guards_;
+  std::unique_ptr<Grinding> grinding_;
 };
 
 }  // namespace dem2d

@@ -92,6 +92,19 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   std::vector<double> r_min(nm, std::numeric_limits<double>::max());
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     r_min[p.material[k]] = std::min(r_min[p.material[k]], p.radius[k]);
+  // Ore scenes: the smallest particle the run can make, from the start (the dt stays safe as
+  // fragments get small): a fragment of the smallest breakable particle, and the smallest fed.
+  if (scene.breakage.present) {
+    const int m = find_material(scene, scene.breakage.material);
+    const double smallest = scene.breakage.minimum_radius /
+                            std::cbrt(static_cast<double>(scene.breakage.fragments_max));
+    if (m >= 0 && r_min[m] != std::numeric_limits<double>::max())
+      r_min[m] = std::min(r_min[m], smallest);
+  }
+  if (scene.feed.present) {
+    const int m = find_material(scene, scene.feed.material);
+    if (m >= 0) r_min[m] = std::min(r_min[m], scene.feed.radius_min);
+  }
   for (std::size_t a = 0; a < nm; ++a) {
     if (r_min[a] == std::numeric_limits<double>::max()) continue;
     const MaterialSpec& m = scene.materials[a];

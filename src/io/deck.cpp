@@ -620,6 +620,9 @@ class DeckParser {
     for (std::size_t i = 0; i < fills.size(); ++i) read_fill(*fills[i], i);
     const auto walls = root.table_array("wall");
     for (std::size_t i = 0; i < walls.size(); ++i) read_wall(*walls[i], i);
+    if (const auto* t = root.table("breakage")) read_breakage(*t);
+    if (const auto* t = root.table("feed")) read_feed(*t);
+    if (const auto* t = root.table("sieve")) read_sieve(*t);
     if (const auto* t = root.table("output")) read_output(*t);
 
     if (materials.empty() &&
@@ -995,6 +998,48 @@ class DeckParser {
       r.invalid("to", "must differ from wall.from (a wall has a length)");
     }
     scene_.walls.push_back(std::move(wall));
+  }
+
+  void read_breakage(const toml::table& table) {
+    const TableReader r(diag_, table, deck::kBreakage);
+    BreakageSpec& b = scene_.breakage;
+    b.present = true;
+    const Accepted accepted = read_keys(r, deck::kBreakage, b);
+    if (accepted.has("fragments_max") && b.fragments_max < b.fragments_min) {
+      r.invalid("fragments_max",
+                fmt::format("must be at least fragments_min = {}", b.fragments_min));
+    }
+  }
+
+  void read_feed(const toml::table& table) {
+    const TableReader r(diag_, table, deck::kFeed);
+    FeedSpec& f = scene_.feed;
+    f.present = true;
+    const Accepted accepted = read_keys(r, deck::kFeed, f);
+    if (accepted.has("period") == accepted.has("mass_rate")) {
+      r.invalid(accepted.has("period") ? "mass_rate" : "period",
+                "give exactly one of period (s between particles) and mass_rate (kg/s)");
+    }
+    if (accepted.has("radius_max") && accepted.has("radius_min") && f.radius_max < f.radius_min) {
+      r.invalid("radius_max", fmt::format("must be at least radius_min = {} m", f.radius_min));
+    }
+    if (accepted.has("point") && !scene_.drum.present) {
+      r.invalid("point", "a feed needs a [drum]");
+    } else if (!scene_.drum.present) {
+      r.invalid("material", "a feed needs a [drum] to place its particles in");
+    }
+  }
+
+  void read_sieve(const toml::table& table) {
+    const TableReader r(diag_, table, deck::kSieve);
+    SieveSpec& s = scene_.sieve;
+    s.present = true;
+    const Accepted accepted = read_keys(r, deck::kSieve, s);
+    if (!(s.box_max.x > s.box_min.x && s.box_max.y > s.box_min.y)) {
+      r.invalid(accepted.has("box_max") ? "box_max" : "box_min",
+                fmt::format("the zone must be above and right of box_min = [{}, {}]", s.box_min.x,
+                            s.box_min.y));
+    }
   }
 
   void read_output(const toml::table& table) {

@@ -102,6 +102,10 @@ DeckTable scene_table(const Scene& scene) {
   }
   root.table_array("particle", std::move(particles));
   root.table_array("wall", keys_tables(deck::kWall, scene.walls, model));
+  if (scene.breakage.present)
+    root.table("breakage", keys_table(deck::kBreakage, scene.breakage, model));
+  if (scene.feed.present) root.table("feed", keys_table(deck::kFeed, scene.feed, model));
+  if (scene.sieve.present) root.table("sieve", keys_table(deck::kSieve, scene.sieve, model));
   root.table("output", keys_table(deck::kOutput, scene.output, model));
   return root;
 }

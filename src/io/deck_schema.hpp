@@ -137,6 +137,7 @@ inline constexpr Bound kUnitFraction{0.0, 1.0, true, false};         // (0, 1]
 inline constexpr Bound kPoissonRatio{0.0, 0.5, false, true};  // [0, 0.5): isotropic, compressible
 inline constexpr Bound kFillFraction{0.0, 0.9, true, true};   // (0, 0.9): room left to place them
 inline constexpr Bound kAtLeastOne{1.0, Bound{}.hi, false, false};  // >= 1 (integers)
+inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (integers)
 
 // A key's value once checked: a number, integer, bool, string (also a choice's word, or
 // "auto"), [x, y], or a list of names.
@@ -729,6 +730,135 @@ inline constexpr Key<WallSpec> kWallKeys[] = {
      .doc = "the wall translates rigidly at this velocity"},
 };
 
+inline constexpr Key<BreakageSpec> kBreakageKeys[] = {
+    {.name = "material",
+     .type = Type::kMaterial,
+     .need = Need::kRequired,
+     .field = member<&BreakageSpec::material>(),
+     .doc = "the material that breaks (ore); its particles carry `damage`"},
+    {.name = "minimum_energy",
+     .unit = "J",
+     .range = kNonNegative,
+     .field = member<&BreakageSpec::minimum_energy>(),
+     .doc = "E_min: a contact whose peak strain energy is below it does no damage (thesis T34, "
+            "Table 1)"},
+    {.name = "strength",
+     .unit = "1/J",
+     .range = kPositive,
+     .field = member<&BreakageSpec::strength>(),
+     .doc = "S in the breakage probability P = 1 - exp(-S E_t), E_t = damage + E - E_min "
+            "(thesis T36, Table 1)"},
+    {.name = "fragments_mean",
+     .range = kPositive,
+     .field = member<&BreakageSpec::fragments_mean>(),
+     .doc = "mean of the normal law of the fragment count (rounded, then clipped to "
+            "[fragments_min, fragments_max])"},
+    {.name = "fragments_sd",
+     .range = kNonNegative,
+     .field = member<&BreakageSpec::fragments_sd>(),
+     .doc = "standard deviation of that law (thesis: 99.7 % of counts between 2 and 6)"},
+    {.name = "fragments_min",
+     .type = Type::kInteger,
+     .range = kAtLeastTwo,
+     .max = 6,
+     .field = member<&BreakageSpec::fragments_min>(),
+     .doc = "fewest fragments"},
+    {.name = "fragments_max",
+     .type = Type::kInteger,
+     .range = kAtLeastTwo,
+     .max = 6,
+     .field = member<&BreakageSpec::fragments_max>(),
+     .allowed = "fragments_min to 6",
+     .doc = "most fragments"},
+    {.name = "minimum_radius",
+     .need = Need::kRequired,
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&BreakageSpec::minimum_radius>(),
+     .doc = "smaller particles do not break; the smallest fragment, minimum_radius / "
+            "fragments_max^(1/3), sets `dt = \"auto\"` from the start"},
+};
+
+inline constexpr Key<FeedSpec> kFeedKeys[] = {
+    {.name = "material",
+     .type = Type::kMaterial,
+     .need = Need::kRequired,
+     .field = member<&FeedSpec::material>()},
+    {.name = "period",
+     .unit = "s",
+     .range = kPositive,
+     .field = member<&FeedSpec::period>(),
+     .written_if = [](const FeedSpec& f) { return f.period > 0.0; },
+     .allowed = "> 0; exactly one of period, mass_rate",
+     .doc = "one particle every `period`"},
+    {.name = "mass_rate",
+     .unit = "kg/s",
+     .range = kPositive,
+     .field = member<&FeedSpec::mass_rate>(),
+     .written_if = [](const FeedSpec& f) { return f.mass_rate > 0.0; },
+     .doc = "a particle whenever the mass fed falls behind mass_rate x (t - start)"},
+    {.name = "radius_min",
+     .need = Need::kRequired,
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&FeedSpec::radius_min>(),
+     .doc = "radii are uniform in [radius_min, radius_max]"},
+    {.name = "radius_max",
+     .need = Need::kRequired,
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&FeedSpec::radius_max>(),
+     .allowed = "≥ radius_min"},
+    {.name = "start",
+     .unit = "s",
+     .range = kNonNegative,
+     .field = member<&FeedSpec::start>(),
+     .doc = "time of the first fed particle"},
+    {.name = "point",
+     .type = Type::kVector,
+     .unit = "m",
+     .field = {[](FeedSpec& f, const Value& v) {
+                 f.has_point = true;
+                 f.point = std::get<Vec2>(v);
+               },
+               [](const FeedSpec& f) -> std::optional<Value> {
+                 return f.has_point ? std::optional<Value>(f.point) : std::nullopt;
+               }},
+     .default_text = "where the charge is thinnest",
+     .doc = "where each particle is placed (it waits while something is there); without it, "
+            "the free point inside the drum farthest from every particle and wall"},
+    {.name = "velocity",
+     .type = Type::kVector,
+     .unit = "m/s",
+     .field = member<&FeedSpec::velocity>(),
+     .doc = "velocity of each fed particle"},
+};
+
+inline constexpr Key<SieveSpec> kSieveKeys[] = {
+    {.name = "material",
+     .type = Type::kMaterial,
+     .need = Need::kRequired,
+     .field = member<&SieveSpec::material>(),
+     .doc = "the material it lets through (ore)"},
+    {.name = "box_min",
+     .type = Type::kVector,
+     .unit = "m",
+     .field = member<&SieveSpec::box_min>(),
+     .doc = "lower left corner of the sieve zone (thesis: 1 m x 1 m around the drum centre)"},
+    {.name = "box_max",
+     .type = Type::kVector,
+     .unit = "m",
+     .field = member<&SieveSpec::box_max>(),
+     .allowed = "above and right of `box_min`",
+     .doc = "upper right corner"},
+    {.name = "aperture",
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&SieveSpec::aperture>(),
+     .doc = "a particle of the material whose centre is in the zone and whose radius is below "
+            "this leaves the mill as product (physics.md section 5 compares the radius)"},
+};
+
 inline constexpr Key<OutputSpec> kOutputKeys[] = {
     {.name = "directory",
      .type = Type::kString,
@@ -772,6 +902,9 @@ inline constexpr Key<Scene> kTopLevelKeys[] = {
     {.name = "fill", .type = Type::kTableArray},
     {.name = "particle", .type = Type::kTableArray},
     {.name = "wall", .type = Type::kTableArray},
+    {.name = "breakage", .type = Type::kTable},
+    {.name = "feed", .type = Type::kTable},
+    {.name = "sieve", .type = Type::kTable},
     {.name = "output", .type = Type::kTable},
 };
 
@@ -785,6 +918,9 @@ inline constexpr Table<LifterSpec> kLifter{"drum.lifter", true, kLifterKeys};
 inline constexpr Table<FillSpec> kFill{"fill", true, kFillKeys};
 inline constexpr Table<ParticleSpec> kParticle{"particle", true, kParticleKeys};
 inline constexpr Table<WallSpec> kWall{"wall", true, kWallKeys};
+inline constexpr Table<BreakageSpec> kBreakage{"breakage", false, kBreakageKeys};
+inline constexpr Table<FeedSpec> kFeed{"feed", false, kFeedKeys};
+inline constexpr Table<SieveSpec> kSieve{"sieve", false, kSieveKeys};
 inline constexpr Table<OutputSpec> kOutput{"output", false, kOutputKeys};
 
 // Calls f(table) for every table, in the order of docs/input.md.
@@ -800,6 +936,9 @@ constexpr void for_each_table(F&& f) {
   f(kFill);
   f(kParticle);
   f(kWall);
+  f(kBreakage);
+  f(kFeed);
+  f(kSieve);
   f(kOutput);
 }
 

@@ -12,10 +12,18 @@
 
 namespace dem2d {
 
-std::vector<std::string> series_columns(bool iterative) {
+namespace {
+bool written(const SeriesColumn& column, bool iterative, bool ore) {
+  return column.only == SeriesOnly::kAlways ||
+         (iterative && column.only == SeriesOnly::kIterative) ||
+         (ore && column.only == SeriesOnly::kOre);
+}
+}  // namespace
+
+std::vector<std::string> series_columns(bool iterative, bool ore) {
   std::vector<std::string> columns;
   for (const SeriesColumn& column : kSeriesColumns) {
-    if (iterative || !column.iterative_only) columns.emplace_back(column.name);
+    if (written(column, iterative, ore)) columns.emplace_back(column.name);
   }
   return columns;
 }
@@ -28,12 +36,12 @@ std::string series_columns_markdown() {
   return out;
 }
 
-SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active)
-    : path_(path), iterative_(iterative) {
+SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active, bool ore)
+    : path_(path), iterative_(iterative), ore_(ore) {
   if (!active) return;
   file_.reset(std::fopen(path_.c_str(), "w"));
   if (!file_) throw IoError(fmt::format("cannot create {}: {}", path_, std::strerror(errno)));
-  put(fmt::format("{}\n", fmt::join(series_columns(iterative_), ",")));
+  put(fmt::format("{}\n", fmt::join(series_columns(iterative_, ore_), ",")));
 }
 
 SeriesWriter::~SeriesWriter() = default;  // fclose flushes; its status cannot be reported
@@ -50,7 +58,7 @@ void SeriesWriter::write(const SeriesRow& r) {
     }
   };
   for (const SeriesColumn& column : kSeriesColumns) {
-    if (column.iterative_only && !iterative_) continue;
+    if (!written(column, iterative_, ore_)) continue;
     if (!line.empty()) line += ',';
     std::visit([&](auto member) { append(r.*member); }, column.value);
   }

@@ -20,44 +20,78 @@
 
 namespace dem2d {
 
+// Which runs write a column.
+enum class SeriesOnly {
+  kAlways,
+  kIterative,  // the iterative integrator
+  kOre,        // ore scenes: [breakage], [feed] or [sieve]
+};
+
 // One column of series.csv.
 struct SeriesColumn {
   std::string_view name;
   std::string_view unit;  // "" in the docs: "–"
   std::variant<double SeriesRow::*, std::int64_t SeriesRow::*> value;
-  bool iterative_only = false;  // written only with the iterative integrator
-  std::string_view doc;         // the docs' "meaning" column (Markdown)
+  SeriesOnly only = SeriesOnly::kAlways;
+  std::string_view doc;  // the docs' "meaning" column (Markdown)
 };
 
 // The columns, in order (docs/output.md; the energy balance is explained there).
 inline constexpr SeriesColumn kSeriesColumns[] = {
-    {"time", "s", &SeriesRow::time, false, "simulated time of the row"},
-    {"step", "", &SeriesRow::step, false, "time steps taken since the start of the run"},
-    {"particles", "", &SeriesRow::particles, false, "particles in the system (all ranks)"},
-    {"contacts", "", &SeriesRow::contacts, false,
+    {"time", "s", &SeriesRow::time, SeriesOnly::kAlways, "simulated time of the row"},
+    {"step", "", &SeriesRow::step, SeriesOnly::kAlways,
+     "time steps taken since the start of the run"},
+    {"particles", "", &SeriesRow::particles, SeriesOnly::kAlways,
+     "particles in the system (all ranks)"},
+    {"contacts", "", &SeriesRow::contacts, SeriesOnly::kAlways,
      "particle–particle plus particle–wall (drum, lifter, wall segment) contacts"},
-    {"kinetic_energy", "J", &SeriesRow::kinetic_energy, false, "Σ ½ m v²"},
-    {"rotational_energy", "J", &SeriesRow::rotational_energy, false, "Σ ½ I ω², I = 2/5 m r²"},
-    {"potential_energy", "J", &SeriesRow::potential_energy, false,
+    {"kinetic_energy", "J", &SeriesRow::kinetic_energy, SeriesOnly::kAlways, "Σ ½ m v²"},
+    {"rotational_energy", "J", &SeriesRow::rotational_energy, SeriesOnly::kAlways,
+     "Σ ½ I ω², I = 2/5 m r²"},
+    {"potential_energy", "J", &SeriesRow::potential_energy, SeriesOnly::kAlways,
      "Σ −m g·x, zero at the origin (can be negative)"},
-    {"elastic_energy", "J", &SeriesRow::elastic_energy, false,
+    {"elastic_energy", "J", &SeriesRow::elastic_energy, SeriesOnly::kAlways,
      "energy stored in the contact springs now: normal, tangential, rolling"},
-    {"dissipated_energy", "J", &SeriesRow::dissipated_energy, false,
+    {"dissipated_energy", "J", &SeriesRow::dissipated_energy, SeriesOnly::kAlways,
      "cumulative energy lost since the start: normal and tangential damping, sliding "
      "friction, rolling resistance"},
-    {"drum_torque", "N m", &SeriesRow::drum_torque, false,
+    {"drum_torque", "N m", &SeriesRow::drum_torque, SeriesOnly::kAlways,
      "torque the drive applies to the drum to keep its prescribed speed (counter-clockwise "
      "positive)"},
-    {"drum_power", "W", &SeriesRow::drum_power, false,
+    {"drum_power", "W", &SeriesRow::drum_power, SeriesOnly::kAlways,
      "`drum_torque` × drum angular speed: the drive's power"},
-    {"drive_work", "J", &SeriesRow::drive_work, false,
+    {"drive_work", "J", &SeriesRow::drive_work, SeriesOnly::kAlways,
      "cumulative work done on the particles by the drive (drum, lifters) and by moving walls"},
-    {"passes", "", &SeriesRow::passes, true,
+    {"passes", "", &SeriesRow::passes, SeriesOnly::kIterative,
      "iterative integrator only: mean number of force passes per step since the previous row"},
+    {"breakages", "", &SeriesRow::breakages, SeriesOnly::kOre,
+     "ore scenes: particles broken since the start"},
+    {"fragments", "", &SeriesRow::fragments, SeriesOnly::kOre,
+     "ore scenes: fragments born since the start"},
+    {"fed_count", "", &SeriesRow::fed_count, SeriesOnly::kOre,
+     "ore scenes: particles fed since the start"},
+    {"fed_mass", "kg", &SeriesRow::fed_mass, SeriesOnly::kOre,
+     "ore scenes: mass fed since the start"},
+    {"discharged_count", "", &SeriesRow::discharged_count, SeriesOnly::kOre,
+     "ore scenes: particles the sieve let out since the start (`product.csv`)"},
+    {"discharged_mass", "kg", &SeriesRow::discharged_mass, SeriesOnly::kOre,
+     "ore scenes: their mass; initial `mill_mass` + `fed_mass` = `mill_mass` + "
+     "`discharged_mass` at every row"},
+    {"mill_mass", "kg", &SeriesRow::mill_mass, SeriesOnly::kOre,
+     "ore scenes: mass of every particle in the mill"},
+    {"ore_mass", "kg", &SeriesRow::ore_mass, SeriesOnly::kOre,
+     "ore scenes: mass of the ore in the mill (the breakage material, else the feed's)"},
+    {"fed_energy", "J", &SeriesRow::fed_energy, SeriesOnly::kOre,
+     "ore scenes: kinetic and potential energy the fed particles brought in (a term of the "
+     "energy balance)"},
+    {"discharged_energy", "J", &SeriesRow::discharged_energy, SeriesOnly::kOre,
+     "ore scenes: kinetic, rotational and potential energy the discharged particles took out "
+     "(a term of the energy balance)"},
 };
 
-// The column names of series.csv, in order ("passes" last, for the iterative integrator).
-std::vector<std::string> series_columns(bool iterative);
+// The column names of series.csv, in order ("passes" for the iterative integrator, then the ore
+// columns for ore scenes).
+std::vector<std::string> series_columns(bool iterative, bool ore = false);
 
 // The column table of docs/output.md (between "<!-- columns: series.csv -->" and
 // "<!-- end columns -->"): header, separator and one line per column, each ending in '\n'.
@@ -67,7 +101,7 @@ class SeriesWriter {
  public:
   // Creates (truncating) `path` and writes the header row. Throws IoError
   // "cannot create PATH: REASON" when it cannot (active writer only).
-  SeriesWriter(const std::string& path, bool iterative, bool active);
+  SeriesWriter(const std::string& path, bool iterative, bool active, bool ore = false);
   ~SeriesWriter();  // flushes and closes; never throws
   SeriesWriter(const SeriesWriter&) = delete;
   SeriesWriter& operator=(const SeriesWriter&) = delete;
@@ -85,6 +119,7 @@ class SeriesWriter {
 
   std::string path_;
   bool iterative_;
+  bool ore_;
   std::unique_ptr<std::FILE, Closer> file_;
 };
 

@@ -64,6 +64,18 @@ std::vector<double> all_gather(MPI_Comm comm, double x) {
   return all;
 }
 
+std::vector<std::int64_t> all_gather(MPI_Comm comm, std::span<const std::int64_t> mine) {
+  const int n = size(comm);
+  std::vector<int> counts(static_cast<std::size_t>(n)), offsets(static_cast<std::size_t>(n), 0);
+  const int count = static_cast<int>(mine.size());
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 1; r < counts.size(); ++r) offsets[r] = offsets[r - 1] + counts[r - 1];
+  std::vector<std::int64_t> all(static_cast<std::size_t>(offsets.back() + counts.back()));
+  MPI_Allgatherv(mine.data(), count, MPI_INT64_T, all.data(), counts.data(), offsets.data(),
+                 MPI_INT64_T, comm);
+  return all;
+}
+
 void broadcast(MPI_Comm comm, std::span<int> values, int root) {
   if (values.empty()) return;
   MPI_Bcast(values.data(), static_cast<int>(values.size()), MPI_INT, root, comm);

@@ -40,6 +40,8 @@ void max_in_place(MPI_Comm comm, std::span<double> values);
 bool any(MPI_Comm comm, bool x);
 // Every rank's `x`, in rank order, on every rank.
 std::vector<double> all_gather(MPI_Comm comm, double x);
+// Every rank's values (any count per rank), concatenated in rank order, on every rank.
+std::vector<std::int64_t> all_gather(MPI_Comm comm, std::span<const std::int64_t> mine);
 // `values` (the same length on every rank) from `root`, in place.
 void broadcast(MPI_Comm comm, std::span<int> values, int root);
 // `root`'s string on every rank (the others' argument is ignored).

@@ -58,6 +58,11 @@ void MpiDomain::max(std::span<double> values) const {
   if (size_ > 1) mpi::max_in_place(comm_, values);
 }
 
+std::vector<std::int64_t> MpiDomain::allgather(std::span<const std::int64_t> mine) const {
+  if (size_ == 1) return {mine.begin(), mine.end()};
+  return mpi::all_gather(comm_, mine);
+}
+
 bool MpiDomain::any(bool x) const { return size_ == 1 ? x : mpi::any(comm_, x); }
 
 int MpiDomain::owner_of(Vec2 x) const {

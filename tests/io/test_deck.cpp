@@ -177,6 +177,31 @@ to = [1.0, 0.0]
 material = "steel"
 velocity = [0.1, 0.0]
 
+[breakage]
+material = "liner"
+minimum_energy = 0.2
+strength = 2.0
+fragments_mean = 3.5
+fragments_sd = 0.5
+fragments_min = 2
+fragments_max = 5
+minimum_radius = 0.03
+
+[feed]
+material = "liner"
+period = 0.5
+radius_min = 0.04
+radius_max = 0.06
+start = 1.0
+point = [0.0, 1.0]
+velocity = [0.0, -1.0]
+
+[sieve]
+material = "liner"
+box_min = [-0.4, -0.5]
+box_max = [0.5, 0.6]
+aperture = 0.03
+
 [output]
 directory = "out/waterfall"
 series_interval = 2.0e-3
@@ -880,7 +905,7 @@ material = "steel"
   EXPECT_TRUE(has_message(messages,
                           "--set nonsense.key=1: error: unknown table [nonsense]; "
                           "valid keys: title, run, contact, material, interaction, "
-                          "drum, fill, particle, wall, output"));
+                          "drum, fill, particle, wall, breakage, feed, sieve, output"));
   EXPECT_EQ(messages.size(), 10u);
 }
 

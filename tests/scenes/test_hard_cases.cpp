@@ -16,7 +16,6 @@
 namespace dem2d {
 namespace {
 
-using testing_support::energy_balance;
 using testing_support::thesis_steel;
 
 ParticleSpec ball(double r, Vec2 x, Vec2 v = {}) {

@@ -45,13 +45,6 @@ inline Scene thesis_drum_scene(int balls, double speed, int sides, double ramp_t
   return s;
 }
 
-// The energy balance of a series row: kinetic + rotational + potential + elastic + dissipated
-// - drive work, constant up to the integrator's error.
-inline double energy_balance(const SeriesRow& r) {
-  return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
-         r.dissipated_energy - r.drive_work;
-}
-
 // An open box of three `material` wall segments: the floor from (-half_width, 0) to
 // (half_width, 0) and two sides up to `height`.
 inline void add_open_box(Scene& s, double half_width, double height, const std::string& material) {

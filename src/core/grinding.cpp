@@ -1,0 +1,291 @@
+#include "core/grinding.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "core/contact_models.hpp"
+#include "core/random.hpp"
+
+namespace dem2d {
+
+namespace {
+
+// Independent streams of draws from the one run seed.
+constexpr std::uint64_t kStreamTest = 0x7e57'0000'0000'0001ULL;
+constexpr std::uint64_t kStreamFragments = 0xf7a6'0000'0000'0002ULL;
+constexpr std::uint64_t kStreamFeed = 0xfeed'0000'0000'0003ULL;
+
+std::uint64_t stream(std::uint64_t seed, std::uint64_t which) { return mix64(seed ^ which); }
+
+// Kinetic, rotational and potential energy of one particle.
+double particle_energy(const ParticleStore& p, std::size_t k, Vec2 gravity) {
+  const double inertia = ParticleStore::sphere_inertia(p.mass[k], p.radius[k]);
+  return 0.5 * p.mass[k] * norm2(p.vel[k]) + 0.5 * inertia * p.omega[k] * p.omega[k] -
+         p.mass[k] * dot(gravity, p.pos[k]);
+}
+
+}  // namespace
+
+Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& domain)
+    : scene_(scene) {
+  if (scene.breakage.present) break_material_ = find_material(scene, scene.breakage.material);
+  if (scene.feed.present) feed_material_ = find_material(scene, scene.feed.material);
+  if (scene.sieve.present) sieve_material_ = find_material(scene, scene.sieve.material);
+  double largest = -1.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    largest = std::max(largest, static_cast<double>(p.id[k]));
+  next_id_ = static_cast<std::int64_t>(domain.max(largest)) + 1;
+  next_feed_try_ = scene.feed.start;
+  if (scene.feed.present && scene.drum.present) {
+    // Candidate feed points: rings inside the drum clear of the shell and the lifters.
+    const DrumSpec& d = scene.drum;
+    double reach = d.radius * (d.sides >= 3 ? std::cos(std::numbers::pi / d.sides) : 1.0);
+    for (const LifterSpec& l : d.lifters) reach = std::min(reach, d.radius - l.height);
+    feed_reach_ = reach;
+    candidates_.push_back(d.center);
+    for (int ring = 1; ring <= 6; ++ring) {
+      const double radius = (reach - scene.feed.radius_max) * ring / 6.0;
+      const int n = 8 * ring;
+      for (int k = 0; k < n; ++k) {
+        const double a = 2.0 * std::numbers::pi * (k + 0.5 * (ring % 2)) / n;
+        candidates_.push_back(d.center + radius * Vec2{std::cos(a), std::sin(a)});
+      }
+    }
+  }
+}
+
+bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
+                          Domain& domain) {
+  std::vector<Broken> broken;
+  if (break_material_ >= 0) {
+    std::vector<Test> tests;
+    collect_tests(p, contacts, tests);
+    broken = run_tests(tests, step, p);
+  }
+  std::vector<char> remove(p.n_owned(), 0);
+  double sieved_mass = 0.0;
+  const std::int64_t sieved = sieve_material_ >= 0 ? sieve(time, p, remove, sieved_mass) : 0;
+  const std::int64_t changes =
+      domain.sum(static_cast<std::int64_t>(broken.size()) + sieved);  // one collective per step
+  if (changes != 0) {
+    births_from_ = next_id_;
+    // The parents as they were, then the store without them and without the product.
+    std::vector<Parent> parents;
+    for (const Broken& b : broken) {
+      const std::size_t k = b.index;
+      parents.push_back(
+          {p.id[k], p.material[k], p.radius[k], b.energy, p.pos[k], p.vel[k], p.omega[k]});
+      remove[k] = 2;
+    }
+    for (std::size_t k = 0; k < p.n_owned(); ++k)
+      if (remove[k] == 1) discharged_energy_ += particle_energy(p, k, scene_.run.gravity);
+    p.remove_if(remove);
+    break_parents(time, parents, p, domain);
+    totals_.discharged_count += domain.sum(sieved);
+    totals_.discharged_mass += domain.sum(sieved_mass);
+  }
+  if (!feed_due(time)) return changes != 0;
+  if (changes == 0) births_from_ = next_id_;
+  const bool fed = feed(time, p, domain);
+  return changes != 0 || fed;
+}
+
+// Every contact of an owned breakable particle past its peak and above the level tested, in
+// the order (particle id, partner): pairs in list order, then walls, then sorted.
+void Grinding::collect_tests(const ParticleStore& p, ContactEngine& contacts,
+                             std::vector<Test>& out) {
+  const std::size_t off = contacts.history_offset("peak_energy");
+  const std::size_t n_owned = p.n_owned();
+  const double r_min = scene_.breakage.minimum_radius;
+  const auto breakable = [&](std::int32_t i) {
+    return static_cast<std::size_t>(i) < n_owned && p.material[i] == break_material_ &&
+           p.radius[i] >= r_min;
+  };
+  const auto due = [&](double* h) {
+    const double peak = h[TrackBreakage::kPeak];
+    return h[TrackBreakage::kEnergy] < peak && peak > h[TrackBreakage::kTested];
+  };
+  PairList& pl = contacts.mutable_pairs();
+  for (std::size_t k = 0; k < pl.size(); ++k) {
+    double* h = pl.history.data() + k * pl.width + off;
+    if (!due(h)) continue;
+    const std::int32_t i = pl.i[k], j = pl.j[k];
+    const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
+    if (breakable(i)) out.push_back({pl.id_i[k], pl.id_j[k], std::size_t(i), peak, tested});
+    if (breakable(j)) out.push_back({pl.id_j[k], pl.id_i[k], std::size_t(j), peak, tested});
+    h[TrackBreakage::kTested] = peak;  // on every rank that lists the pair alike
+  }
+  WallPairList& wl = contacts.mutable_wall_pairs();
+  for (std::size_t k = 0; k < wl.size(); ++k) {
+    double* h = wl.history.data() + k * wl.width + off;
+    if (!due(h)) continue;
+    const std::int32_t i = wl.particle[k];
+    if (breakable(i))
+      out.push_back({wl.id[k], -1 - std::int64_t{wl.element[k]}, std::size_t(i),
+                     h[TrackBreakage::kPeak], h[TrackBreakage::kTested]});
+    h[TrackBreakage::kTested] = h[TrackBreakage::kPeak];
+  }
+  std::sort(out.begin(), out.end(), [](const Test& a, const Test& b) {
+    return a.id < b.id || (a.id == b.id && a.partner < b.partner);
+  });
+}
+
+// The tests in order; returns the particles that break (local index, the test's peak energy),
+// in store order.
+std::vector<Grinding::Broken> Grinding::run_tests(const std::vector<Test>& tests, std::int64_t step,
+                                                  ParticleStore& p) const {
+  const BreakageSpec& b = scene_.breakage;
+  const std::uint64_t seed = stream(scene_.run.seed, kStreamTest);
+  Field<double>& damage = *p.damage();
+  std::vector<Broken> broken;
+  std::int64_t last_broken = -1;
+  for (const Test& t : tests) {
+    if (t.id == last_broken) continue;  // already broken in this step
+    const double energy = t.peak - std::max(t.tested, b.minimum_energy);
+    if (energy <= 0.0) continue;
+    const double e_t = damage[t.index] + energy;
+    const double probability = 1.0 - std::exp(-b.strength * e_t);
+    const std::uint64_t key =
+        mix64(static_cast<std::uint64_t>(t.id)) ^ static_cast<std::uint64_t>(t.partner);
+    if (random_uniform(seed, key, static_cast<std::uint64_t>(step)) < probability) {
+      broken.push_back({t.index, t.peak});
+      last_broken = t.id;
+    } else {
+      damage[t.index] = e_t;
+    }
+  }
+  std::sort(broken.begin(), broken.end(),
+            [](const Broken& x, const Broken& y) { return x.index < y.index; });
+  return broken;
+}
+
+int Grinding::fragment_count(std::int64_t parent) const {
+  const BreakageSpec& b = scene_.breakage;
+  const double z = random_normal(stream(scene_.run.seed, kStreamFragments),
+                                 static_cast<std::uint64_t>(parent), 0);
+  const double n = std::round(b.fragments_mean + b.fragments_sd * z);
+  return static_cast<int>(std::clamp(n, double(b.fragments_min), double(b.fragments_max)));
+}
+
+// Every rank's parents of this step, sorted by id, take the next ids in turn; this rank's are
+// replaced by their fragments (the parents are already out of the store).
+void Grinding::break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
+                             Domain& domain) {
+  std::vector<std::int64_t> mine;
+  for (const Parent& parent : parents) mine.push_back(parent.id);
+  std::vector<std::int64_t> all = domain.allgather(mine);
+  std::sort(all.begin(), all.end());
+  std::int64_t id = next_id_;
+  const std::uint64_t seed = stream(scene_.run.seed, kStreamFragments);
+  for (const std::int64_t parent_id : all) {
+    const int n = fragment_count(parent_id);
+    const auto it = std::find(mine.begin(), mine.end(), parent_id);
+    if (it != mine.end()) {
+      const Parent& q = parents[static_cast<std::size_t>(it - mine.begin())];
+      breakages_.push_back({time, q.id, q.radius, q.energy, n, id});
+      const double r_f = q.radius / std::cbrt(static_cast<double>(n));
+      const double turn =
+          2.0 * std::numbers::pi * random_uniform(seed, static_cast<std::uint64_t>(q.id), 1);
+      const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
+      for (int f = 0; f < n; ++f) {
+        const double a = turn + 2.0 * std::numbers::pi * f / n;
+        const Vec2 offset = (q.radius - r_f) * Vec2{std::cos(a), std::sin(a)};
+        p.add(id + f, q.material, r_f, density, q.x + offset,
+              q.v + q.omega * Vec2{-offset.y, offset.x}, q.omega);
+      }
+    }
+    id += n;
+    totals_.breakages += 1;
+    totals_.fragments += n;
+  }
+  next_id_ = id;
+}
+
+std::int64_t Grinding::sieve(double time, const ParticleStore& p, std::vector<char>& remove,
+                             double& mass) {
+  const SieveSpec& s = scene_.sieve;
+  std::int64_t n = 0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    const Vec2 x = p.pos[k];
+    if (p.material[k] != sieve_material_ || !(p.radius[k] < s.aperture) || x.x < s.box_min.x ||
+        x.x > s.box_max.x || x.y < s.box_min.y || x.y > s.box_max.y)
+      continue;
+    remove[k] = 1;
+    product_.push_back({time, p.id[k], p.radius[k], p.mass[k]});
+    mass += p.mass[k];
+    ++n;
+  }
+  return n;
+}
+
+bool Grinding::feed_due(double time) const {
+  const FeedSpec& f = scene_.feed;
+  if (feed_material_ < 0 || time < next_feed_try_) return false;
+  if (f.period > 0.0) return time >= f.start + static_cast<double>(totals_.fed_count) * f.period;
+  return totals_.fed_mass <= f.mass_rate * (time - f.start);
+}
+
+double Grinding::feed_radius() const {
+  const FeedSpec& f = scene_.feed;
+  const double u = random_uniform(stream(scene_.run.seed, kStreamFeed),
+                                  static_cast<std::uint64_t>(totals_.fed_count), 0);
+  return f.radius_min + u * (f.radius_max - f.radius_min);
+}
+
+// One fed particle, where the charge is thinnest (or at the feed point), on the rank that owns
+// that place; false (on every rank) when no place is free: the feed waits 1 ms.
+bool Grinding::feed(double time, ParticleStore& p, Domain& domain) {
+  const FeedSpec& f = scene_.feed;
+  const double r = feed_radius();
+  const std::vector<Vec2> points = f.has_point ? std::vector<Vec2>{f.point} : candidates_;
+  // Clearance of every point: distance to the nearest particle surface (all ranks) and, for
+  // the candidates, to the ring that keeps clear of shell and lifters.
+  std::vector<double> neg_clear(points.size());
+  for (std::size_t c = 0; c < points.size(); ++c) {
+    double clear = std::numeric_limits<double>::max();
+    if (!f.has_point) clear = feed_reach_ - norm(points[c] - scene_.drum.center);
+    for (std::size_t k = 0; k < p.n_owned(); ++k)
+      clear = std::min(clear, norm(points[c] - p.pos[k]) - p.radius[k]);
+    neg_clear[c] = -clear;
+  }
+  domain.max(neg_clear);
+  std::size_t best = 0;
+  for (std::size_t c = 1; c < points.size(); ++c)
+    if (neg_clear[c] < neg_clear[best]) best = c;
+  if (-neg_clear[best] < r) {
+    next_feed_try_ = time + 1e-3;
+    return false;
+  }
+  const double density = scene_.materials[static_cast<std::size_t>(feed_material_)].density;
+  const double mass = ParticleStore::sphere_mass(r, density);
+  if (domain.owns(points[best])) {
+    p.clear_ghosts();
+    const std::size_t k =
+        p.add(next_id_, feed_material_, r, density, points[best], f.velocity, 0.0);
+    fed_energy_ += particle_energy(p, k, scene_.run.gravity);
+  }
+  ++next_id_;
+  totals_.fed_count += 1;
+  totals_.fed_mass += mass;
+  return true;
+}
+
+void Grinding::exclude_births(ContactEngine& contacts) const {
+  // Marked: the next evaluation (at the birth state) takes the overlap as the birth overlap; a
+  // contact apart then is cleared by the kernel like any other.
+  const std::size_t off = contacts.history_offset("peak_energy") + TrackBreakage::kBirthOverlap;
+  PairList& pl = contacts.mutable_pairs();
+  for (std::size_t k = 0; k < pl.size(); ++k)
+    if (pl.id_i[k] >= births_from_ || pl.id_j[k] >= births_from_)
+      pl.history[k * pl.width + off] = -1.0;
+  WallPairList& wl = contacts.mutable_wall_pairs();
+  for (std::size_t k = 0; k < wl.size(); ++k)
+    if (wl.id[k] >= births_from_) wl.history[k * wl.width + off] = -1.0;
+}
+
+std::vector<BreakageRecord> Grinding::take_breakages() { return std::exchange(breakages_, {}); }
+std::vector<ProductRecord> Grinding::take_product() { return std::exchange(product_, {}); }
+
+}  // namespace dem2d

@@ -1,0 +1,132 @@
+// Grinding: ore breakage, feed and sieve (physics.md section 5, thesis sections 1.8 and 2.3).
+//
+// After every committed step of an ore scene (one with [breakage], [feed] or [sieve]):
+//   tests     every contact of a breakable particle whose strain energy has fallen below its
+//             peak, with a peak above the level already tested, is a breakage test (the contact
+//             reached its peak; a contact that is loaded again past that peak is tested again
+//             for the excess): E = peak - max(tested, E_min) (the thesis's E - E_min for the
+//             first test); E_t = damage + E; the particle breaks with P = 1 - exp(-S E_t)
+//             (T36), or else damage += E (T34). Tests run on the owner, in the order of
+//             (particle id, partner), with counter-based draws keyed by (particle id, partner,
+//             step): the same on any rank count;
+//   breaks    the parent is replaced by n equal spheres (n from a normal law, rounded and
+//             clipped), r_f = r / n^(1/3) (mass conserved), centred on a regular n-gon of
+//             radius r - r_f inside the parent's circle (turned by a drawn angle), each with the
+//             parent's rigid-body velocity at its centre and its spin: mass and momentum are
+//             conserved, kinetic energy does not grow. Ids: the parents of the step, sorted by
+//             id over all ranks, take the next ids in turn;
+//   sieve     a particle of the sieve's material with its centre in the zone and its radius
+//             below the aperture leaves as product, on its owner;
+//   feed      a particle of the feed's radius law (drawn from the feed count) at the feed point,
+//             or where the charge is thinnest: of a fixed set of candidate points inside the
+//             drum, the one farthest from every particle surface and the shell; placed on the
+//             rank that owns that point, when nothing is within the new particle's radius.
+// A step that changed the population tells the simulation, which rebuilds the lists (the new
+// particles migrate like any other), marks every listed contact of a newborn particle as
+// excluded (the first force evaluation keeps only those that overlap: core/contact_models.hpp,
+// TrackBreakage) and books the energy the change released.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/contact_engine.hpp"
+#include "core/domain.hpp"
+#include "core/particles.hpp"
+#include "core/scene.hpp"
+
+namespace dem2d {
+
+// Counts and masses since the start (the same on every rank).
+struct GrindingTotals {
+  std::int64_t breakages = 0, fragments = 0, fed_count = 0, discharged_count = 0;
+  double fed_mass = 0.0, discharged_mass = 0.0;
+};
+
+// One breakage (breakages.csv) and one discharged particle (product.csv).
+struct BreakageRecord {
+  double time = 0.0;
+  std::int64_t parent = 0;
+  double radius = 0.0, energy = 0.0;  // the test's peak energy E (J)
+  int fragments = 0;
+  std::int64_t first_id = 0;  // the fragments' ids: first_id, first_id + 1, ...
+};
+struct ProductRecord {
+  double time = 0.0;
+  std::int64_t id = 0;
+  double radius = 0.0, mass = 0.0;
+};
+
+class Grinding {
+ public:
+  // The next free id is one above the largest id of the particles placed (all ranks).
+  Grinding(const Scene& scene, const ParticleStore& p, const Domain& domain);
+
+  // After a committed step at `time`: tests, breaks, sieve and feed (collective). Returns true,
+  // on every rank alike, when the population changed; the caller then rebuilds and calls
+  // exclude_births().
+  bool after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
+                  Domain& domain);
+  // After the rebuild that follows a change: every listed contact of a particle born in it is
+  // excluded (the next evaluation keeps the overlapping ones).
+  void exclude_births(ContactEngine& contacts) const;
+
+  const GrindingTotals& totals() const { return totals_; }
+  // This rank's energy carried in by the feed and out by the sieve since the start (J): kinetic,
+  // rotational and potential energy of the particles as they came and went.
+  double fed_energy() const { return fed_energy_; }
+  double discharged_energy() const { return discharged_energy_; }
+  // This rank's records since the last call (the breakages of every rank on rank 0 only when
+  // the caller gathers them; here: this rank's own).
+  std::vector<BreakageRecord> take_breakages();
+  std::vector<ProductRecord> take_product();
+  std::int64_t next_id() const { return next_id_; }
+  // The ore: the breakage material, else the feed's, else the sieve's.
+  int ore_material() const {
+    return break_material_ >= 0 ? break_material_
+                                : (feed_material_ >= 0 ? feed_material_ : sieve_material_);
+  }
+
+ private:
+  struct Test {
+    std::int64_t id, partner;  // partner: particle id, or -1 - wall element
+    std::size_t index;         // local index of the particle
+    double peak, tested;
+  };
+  struct Broken {
+    std::size_t index;
+    double energy;
+  };
+  struct Parent {
+    std::int64_t id;
+    std::int32_t material;
+    double radius, energy;
+    Vec2 x, v;
+    double omega;
+  };
+  void collect_tests(const ParticleStore& p, ContactEngine& contacts, std::vector<Test>& out);
+  std::vector<Broken> run_tests(const std::vector<Test>& tests, std::int64_t step,
+                                ParticleStore& p) const;
+  int fragment_count(std::int64_t parent) const;
+  void break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
+                     Domain& domain);
+  std::int64_t sieve(double time, const ParticleStore& p, std::vector<char>& remove, double& mass);
+  bool feed(double time, ParticleStore& p, Domain& domain);
+  bool feed_due(double time) const;
+  double feed_radius() const;
+
+  const Scene& scene_;
+  int break_material_ = -1, feed_material_ = -1, sieve_material_ = -1;
+  std::size_t tracker_offset_ = 0;  // where TrackBreakage's slots start in a history
+  std::int64_t next_id_ = 0;
+  std::int64_t births_from_ = -1;  // ids >= this were born in the last change
+  double next_feed_try_ = 0.0;     // s: a blocked feed waits until then
+  std::vector<Vec2> candidates_;   // feed: where the charge may be thinnest
+  double feed_reach_ = 0.0;        // m from the drum centre clear of shell and lifters
+  GrindingTotals totals_;
+  double fed_energy_ = 0.0, discharged_energy_ = 0.0;
+  std::vector<BreakageRecord> breakages_;
+  std::vector<ProductRecord> product_;
+};
+
+}  // namespace dem2d

@@ -1,0 +1,57 @@
+#include "io/ore_logs.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <iterator>
+
+#include "core/errors.hpp"
+
+namespace dem2d {
+
+OreLogs::OreLogs(const std::string& directory, bool active)
+    : product_path_(directory + "/product.csv"), breakages_path_(directory + "/breakages.csv") {
+  if (!active) return;
+  for (auto [file, path, header] :
+       {std::tuple{&product_, &product_path_, "time,id,radius,mass\n"},
+        std::tuple{&breakages_, &breakages_path_,
+                   "time,parent_id,radius,energy,fragments,first_fragment_id\n"}}) {
+    file->reset(std::fopen(path->c_str(), "w"));
+    if (!*file) throw IoError(fmt::format("cannot create {}: {}", *path, std::strerror(errno)));
+    put(file->get(), *path, header);
+  }
+}
+
+void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRecord> product) {
+  if (!product_) return;
+  std::sort(breakages.begin(), breakages.end(), [](const auto& a, const auto& b) {
+    return a.time < b.time || (a.time == b.time && a.parent < b.parent);
+  });
+  std::sort(product.begin(), product.end(), [](const auto& a, const auto& b) {
+    return a.time < b.time || (a.time == b.time && a.id < b.id);
+  });
+  std::string text;
+  for (const ProductRecord& r : product)
+    fmt::format_to(std::back_inserter(text), "{:.17g},{},{:.17g},{:.17g}\n", r.time, r.id, r.radius,
+                   r.mass);
+  if (!text.empty()) put(product_.get(), product_path_, text);
+  text.clear();
+  for (const BreakageRecord& r : breakages)
+    fmt::format_to(std::back_inserter(text), "{:.17g},{},{:.17g},{:.17g},{},{}\n", r.time, r.parent,
+                   r.radius, r.energy, r.fragments, r.first_id);
+  if (!text.empty()) put(breakages_.get(), breakages_path_, text);
+}
+
+void OreLogs::put(std::FILE* f, const std::string& path, const std::string& text) {
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fflush(f) != 0) {
+    const int e = errno;
+    std::clearerr(f);
+    throw IoError(
+        fmt::format("cannot write {}: {}", path, e != 0 ? std::strerror(e) : "write error"));
+  }
+}
+
+}  // namespace dem2d

@@ -1,0 +1,32 @@
+// product.csv and breakages.csv of ore scenes (docs/output.md): one row per discharged particle
+// (time, id, radius, mass) and one per breakage (time, parent id, radius, the test's peak
+// energy, fragment count, first fragment id). Rows are appended in (time, id) order and flushed
+// at every series row; only the active writer (rank 0) touches the files.
+#pragma once
+
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/grinding.hpp"
+
+namespace dem2d {
+
+class OreLogs {
+ public:
+  // Creates (truncating) both files with their headers. Throws IoError when it cannot.
+  OreLogs(const std::string& directory, bool active);
+  // Appends the records (of every rank, gathered by the caller), sorted by (time, id).
+  void write(std::vector<BreakageRecord> breakages, std::vector<ProductRecord> product);
+
+ private:
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  void put(std::FILE* f, const std::string& path, const std::string& text);
+  std::string product_path_, breakages_path_;
+  std::unique_ptr<std::FILE, Closer> product_, breakages_;
+};
+
+}  // namespace dem2d
