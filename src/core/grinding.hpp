@@ -117,7 +117,6 @@ class Grinding {
 
   const Scene& scene_;
   int break_material_ = -1, feed_material_ = -1, sieve_material_ = -1;
-  std::size_t tracker_offset_ = 0;  // where TrackBreakage's slots start in a history
   std::int64_t next_id_ = 0;
   std::int64_t births_from_ = -1;  // ids >= this were born in the last change
   double next_feed_try_ = 0.0;     // s: a blocked feed waits until then
