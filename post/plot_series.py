@@ -7,6 +7,8 @@ The energy balance (docs/output.md) is
 
     kinetic + rotational + potential + elastic + dissipated - drive_work = constant,
 
+(ore scenes: - fed_energy + discharged_energy as well)
+
 so the residual plotted in the bottom panel, that sum minus its value in the first row, should
 stay near zero; its size relative to the largest energy term measures how well a run conserves
 energy. The figure is written as a PNG (default: series.png beside the CSV), and a one-line
@@ -54,6 +56,8 @@ def energy_residual(s):
         + s.get("elastic_energy", zero)
         + s.get("dissipated_energy", zero)
         - s.get("drive_work", zero)
+        - s.get("fed_energy", zero)  # ore scenes: energy carried in and out
+        + s.get("discharged_energy", zero)
     )
     residual = total - total[0] if len(total) else total
     terms = [np.abs(s[c] - (s[c][0] if c == "potential_energy" else 0.0))

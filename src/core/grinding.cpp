@@ -62,7 +62,7 @@ bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, Cont
   if (break_material_ >= 0) {
     std::vector<Test> tests;
     collect_tests(p, contacts, tests);
-    broken = run_tests(tests, step, p);
+    if (time >= scene_.breakage.start) broken = run_tests(tests, step, p);
   }
   std::vector<char> remove(p.n_owned(), 0);
   double sieved_mass = 0.0;
@@ -273,6 +273,7 @@ bool Grinding::feed(double time, ParticleStore& p, Domain& domain) {
 }
 
 void Grinding::exclude_births(ContactEngine& contacts) const {
+  if (break_material_ < 0) return;  // only fragments are born overlapping
   // Marked: the next evaluation (at the birth state) takes the overlap as the birth overlap; a
   // contact apart then is cleared by the kernel like any other.
   const std::size_t off = contacts.history_offset("peak_energy") + TrackBreakage::kBirthOverlap;

@@ -8,7 +8,8 @@
 //             first test); E_t = damage + E; the particle breaks with P = 1 - exp(-S E_t)
 //             (T36), or else damage += E (T34). Tests run on the owner, in the order of
 //             (particle id, partner), with counter-based draws keyed by (particle id, partner,
-//             step): the same on any rank count;
+//             step): the same on any rank count. Before [breakage] start, contacts past their
+//             peak are marked tested and do no damage;
 //   breaks    the parent is replaced by n equal spheres (n from a normal law, rounded and
 //             clipped), r_f = r / n^(1/3) (mass conserved), centred on a regular n-gon of
 //             radius r - r_f inside the parent's circle (turned by a drawn angle), each with the

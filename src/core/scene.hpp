@@ -141,6 +141,7 @@ struct BreakageSpec {
   int fragments_min = 2;
   int fragments_max = 6;
   double minimum_radius = 0.0;  // m: particles smaller than this do not break
+  double start = 0.0;           // s: contacts that peak before this time do no damage
 };
 
 // Ore feed: one particle every `period` s (or as a mass rate), radius uniform in

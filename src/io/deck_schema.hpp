@@ -777,6 +777,12 @@ inline constexpr Key<BreakageSpec> kBreakageKeys[] = {
      .field = member<&BreakageSpec::minimum_radius>(),
      .doc = "smaller particles do not break; the smallest fragment, minimum_radius / "
             "fragments_max^(1/3), sets `dt = \"auto\"` from the start"},
+    {.name = "start",
+     .unit = "s",
+     .range = kNonNegative,
+     .field = member<&BreakageSpec::start>(),
+     .doc = "contacts that peak before this time do no damage (the charge falls from its fill "
+            "first)"},
 };
 
 inline constexpr Key<FeedSpec> kFeedKeys[] = {

@@ -87,8 +87,8 @@ done
 # included: snapshots bit-identical by id, product.csv and breakages.csv identical, and the mass
 # balance initial + fed = mill + discharged to round-off at every row.
 for np in 1 2 3; do
-  expect "grinding np$np" 0 'done: 1.25 s simulated' -- mpirun -np "$np" --oversubscribe "$dem2d" \
-    "$src/inputs/grinding.in" --set run.duration=1.25 --set output.snapshot_interval=0.25 --output "$tmp/gr$np"
+  expect "grinding np$np" 0 'done: 1.6 s simulated' -- mpirun -np "$np" --oversubscribe "$dem2d" \
+    "$src/inputs/grinding.in" --set run.duration=1.6 --set output.snapshot_interval=0.4 --output "$tmp/gr$np"
 done
 for np in 2 3; do
   expect "grinding np$np snapshots identical to np1" 0 'bit-identical' -- /usr/bin/python3 \

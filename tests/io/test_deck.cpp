@@ -186,6 +186,7 @@ fragments_sd = 0.5
 fragments_min = 2
 fragments_max = 5
 minimum_radius = 0.03
+start = 0.5
 
 [feed]
 material = "liner"

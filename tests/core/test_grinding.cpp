@@ -1,0 +1,298 @@
+// Grinding (physics.md section 5, thesis T34-T36): the breakage law's statistics, the fragment
+// law, conservation at a break, the sieve and the feed.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+
+#include "core/simulation.hpp"
+#include "support/thesis.hpp"
+
+namespace dem2d {
+namespace {
+
+// The ore of the thesis's Table 1.
+MaterialSpec thesis_ore() {
+  MaterialSpec m;
+  m.name = "ore";
+  m.density = 4800.0;
+  m.youngs_modulus = 6.0e10;
+  m.poisson_ratio = 0.25;
+  m.shear_modulus = 2.4e10;
+  m.restitution = 0.73;
+  m.sliding_friction = 0.1;
+  return m;
+}
+
+// n ore spheres of radius r side by side above a floor, all moving down at v (no gravity):
+// they strike the floor at the same instant with the same energy.
+Scene impacts(int n, double r, double v, double strength) {
+  Scene s;
+  s.deck_path = "test";
+  s.materials.push_back(thesis_ore());
+  s.contact.rolling = RollingModelKind::kNone;
+  s.run.gravity = {0.0, 0.0};
+  s.run.dt_auto = true;
+  s.run.seed = 7;
+  for (int k = 0; k < n; ++k) {
+    ParticleSpec p;
+    p.material = "ore";
+    p.radius = r;
+    p.position = {3.0 * r * k, r + 1e-3};
+    p.velocity = {0.0, -v};
+    s.particles.push_back(p);
+  }
+  WallSpec floor;
+  floor.from = {-r, 0.0};
+  floor.to = {3.0 * r * n, 0.0};
+  floor.material = "ore";
+  s.walls.push_back(floor);
+  s.breakage.present = true;
+  s.breakage.material = "ore";
+  s.breakage.strength = strength;
+  s.breakage.minimum_radius = 0.9 * r;  // fragments do not break again
+  return s;
+}
+
+TEST(Grinding, BreakFractionOfEqualImpactsIsInItsBinomialBandAndFragmentsFollowTheirLaw) {
+  const int n = 400;
+  Simulation sim(impacts(n, 0.05, 1.0, 0.7));
+  sim.run_until(0.004);  // one impact each (the contact lasts about 0.3 ms)
+  const std::vector<BreakageRecord> breaks = sim.grinding()->take_breakages();
+  ASSERT_GT(breaks.size(), 0u);
+  // Every particle met the floor alike: one peak energy, one probability (T36).
+  const double e = breaks.front().energy;
+  for (const BreakageRecord& b : breaks) EXPECT_NEAR(b.energy, e, 1e-9 * e);
+  const double p = 1.0 - std::exp(-0.7 * (e - 0.1));
+  const double fraction = static_cast<double>(breaks.size()) / n;
+  EXPECT_NEAR(fraction, p, 4.0 * std::sqrt(p * (1.0 - p) / n)) << "E = " << e << " J";
+  // Survivors carry the damage E - E_min (T34).
+  const ParticleStore& ps = sim.particles();
+  int survivors = 0;
+  for (std::size_t k = 0; k < ps.n_owned(); ++k) {
+    if (ps.id[k] >= n) continue;
+    ++survivors;
+    EXPECT_NEAR((*ps.damage())[k], e - 0.1, 1e-9);
+  }
+  EXPECT_EQ(survivors + static_cast<int>(breaks.size()), n);
+  // Fragment counts: normal law of mean 4 and sd 2/3, rounded and clipped to [2, 6].
+  double mean = 0.0;
+  for (const BreakageRecord& b : breaks) {
+    EXPECT_GE(b.fragments, 2);
+    EXPECT_LE(b.fragments, 6);
+    mean += b.fragments / static_cast<double>(breaks.size());
+  }
+  EXPECT_NEAR(mean, 4.0, 4.0 * (2.0 / 3.0) / std::sqrt(static_cast<double>(breaks.size())));
+}
+
+// Two runs alike until the break: one whose ore cannot break (strength tiny) and one whose ore
+// breaks at its first test. At the break the fragments hold the parent's mass and momentum and
+// no more kinetic energy, and the energy balance holds through it.
+TEST(Grinding, ABreakConservesMassAndMomentumAndCreatesNoEnergy) {
+  Scene s = impacts(1, 0.05, 3.0, 1.0e9);
+  s.particles[0].velocity = {0.7, -3.0};
+  s.particles[0].spin = 20.0;
+  Scene whole = s;
+  whole.breakage.strength = 1.0e-30;
+  Simulation breaks(s), keeps(whole);
+  const double k0 = breaks.diagnostics().kinetic_energy;
+  while (breaks.grinding()->totals().breakages == 0) {
+    const SeriesRow before = breaks.diagnostics();
+    const double kept_before = energy_balance(keeps.diagnostics());
+    breaks.step();
+    keeps.step();
+    ASSERT_LT(breaks.time(), 0.01);
+    if (breaks.grinding()->totals().breakages == 0) continue;
+    const ParticleStore& f = breaks.particles();
+    const ParticleStore& q = keeps.particles();
+    double mass = 0.0, kinetic = 0.0;
+    Vec2 momentum{};
+    for (std::size_t k = 0; k < f.n_owned(); ++k) {
+      mass += f.mass[k];
+      momentum += f.mass[k] * f.vel[k];
+      kinetic +=
+          0.5 * f.mass[k] * norm2(f.vel[k]) +
+          0.5 * ParticleStore::sphere_inertia(f.mass[k], f.radius[k]) * f.omega[k] * f.omega[k];
+    }
+    const double parent_kinetic =
+        0.5 * q.mass[0] * norm2(q.vel[0]) +
+        0.5 * ParticleStore::sphere_inertia(q.mass[0], q.radius[0]) * q.omega[0] * q.omega[0];
+    EXPECT_GE(f.n_owned(), 2u);
+    EXPECT_NEAR(mass, q.mass[0], 1e-12 * q.mass[0]);
+    EXPECT_NEAR(momentum.x, q.mass[0] * q.vel[0].x, 1e-12 * q.mass[0]);
+    EXPECT_NEAR(momentum.y, q.mass[0] * q.vel[0].y, 1e-12 * q.mass[0]);
+    EXPECT_LE(kinetic, parent_kinetic);
+    const SeriesRow after = breaks.diagnostics();
+    EXPECT_GE(after.dissipated_energy, before.dissipated_energy);  // the break released energy
+    // The step's own integration error is the same in both runs; the break adds nothing to it.
+    const double kept_step = energy_balance(keeps.diagnostics()) - kept_before;
+    EXPECT_NEAR(energy_balance(after) - energy_balance(before), kept_step, 1e-9 * k0);
+  }
+}
+
+// Fragments overlap each other at birth and must not repel: without gravity and walls they
+// move apart only by the parent's spin, force-free, and the pair's history ends when they part.
+TEST(Grinding, BirthOverlapsGiveNoForceUntilTheBodiesPart) {
+  Scene s = impacts(1, 0.05, 3.0, 1.0e9);
+  s.particles[0].spin = 50.0;
+  Simulation sim(s);
+  while (sim.grinding()->totals().breakages == 0) sim.step();
+  const ParticleStore& p = sim.particles();
+  std::map<std::int64_t, Vec2> v0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) v0[p.id[k]] = p.vel[k];
+  // Away from the floor the fragments fly force-free while they still overlap.
+  sim.run_until(sim.time() + 0.002);
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    if (p.pos[k].y < p.radius[k] + 0.01) continue;  // still at the floor
+    EXPECT_NEAR(norm(p.vel[k] - v0[p.id[k]]), 0.0, 1e-9) << "fragment " << p.id[k];
+  }
+  EXPECT_LT(sim.last_totals().max_overlap, 0.25);  // birth overlaps are not the guard's concern
+}
+
+TEST(Grinding, TheSieveRemovesOnlySmallOreInsideItsZone) {
+  Scene s;
+  s.deck_path = "test";
+  s.materials = {thesis_ore(), testing_support::thesis_steel()};
+  s.run.gravity = {0.0, 0.0};
+  const auto add = [&s](const char* material, double r, Vec2 x) {
+    ParticleSpec p;
+    p.material = material;
+    p.radius = r;
+    p.position = x;
+    s.particles.push_back(p);
+  };
+  add("ore", 0.03, {0.0, 0.0});     // small ore inside: leaves
+  add("ore", 0.03, {2.0, 0.0});     // small ore outside
+  add("ore", 0.05, {0.3, 0.3});     // large ore inside
+  add("steel", 0.03, {-0.3, 0.3});  // small steel inside
+  s.sieve.present = true;
+  s.sieve.material = "ore";
+  Simulation sim(s);
+  const double m0 = sim.diagnostics().mill_mass;
+  sim.step();
+  const ParticleStore& p = sim.particles();
+  ASSERT_EQ(p.n_owned(), 3u);
+  for (std::size_t k = 0; k < p.n_owned(); ++k) EXPECT_NE(p.id[k], 0);
+  const std::vector<ProductRecord> product = sim.grinding()->take_product();
+  ASSERT_EQ(product.size(), 1u);
+  EXPECT_EQ(product[0].id, 0);
+  const SeriesRow r = sim.diagnostics();
+  EXPECT_EQ(r.discharged_count, 1);
+  EXPECT_DOUBLE_EQ(r.mill_mass + r.discharged_mass, m0);
+}
+
+TEST(Grinding, FedParticlesNeverOverlapAndTheMassBalanceHolds) {
+  Scene s = testing_support::thesis_drum_scene(120, 1.5, 16);
+  s.materials.push_back(thesis_ore());
+  s.feed.present = true;
+  s.feed.material = "ore";
+  s.feed.period = 0.002;
+  s.feed.radius_min = 0.05;
+  s.feed.radius_max = 0.08;
+  Simulation sim(s);
+  const double m0 = sim.diagnostics().mill_mass;
+  std::int64_t seen = 0;
+  while (sim.time() < 0.1) {
+    sim.step();
+    const ParticleStore& p = sim.particles();
+    const std::int64_t fed = sim.grinding()->totals().fed_count;
+    if (fed == seen) continue;
+    seen = fed;
+    // The newest particle touches nothing and lies inside the drum.
+    const auto newest = std::max_element(p.id.data(), p.id.data() + p.n_owned()) - p.id.data();
+    const Vec2 x = p.pos[static_cast<std::size_t>(newest)];
+    const double r = p.radius[static_cast<std::size_t>(newest)];
+    EXPECT_LT(norm(x) + r, 2.5 * std::cos(std::numbers::pi / 16));
+    for (std::size_t k = 0; k < p.n_owned(); ++k) {
+      if (k == static_cast<std::size_t>(newest)) continue;
+      EXPECT_GE(norm(p.pos[k] - x), p.radius[k] + r) << "fed particle " << p.id[newest];
+    }
+  }
+  EXPECT_GE(seen, 45);
+  const SeriesRow r = sim.diagnostics();
+  EXPECT_NEAR(r.mill_mass, m0 + r.fed_mass, 1e-12 * m0);
+}
+
+// Damage accumulates over impacts (T34): an unbreakable ore sphere bounces between two walls;
+// after each contact its damage has grown by that contact's peak strain energy less E_min.
+TEST(Grinding, DamageAccumulatesOverImpacts) {
+  Scene s = impacts(1, 0.05, 4.0, 1.0e-30);
+  WallSpec ceiling;
+  ceiling.from = {0.2, 0.3};
+  ceiling.to = {-0.2, 0.3};
+  ceiling.material = "ore";
+  s.walls.push_back(ceiling);
+  Simulation sim(s);
+  const std::size_t slot = sim.contacts().history_offset("peak_energy");
+  double expected = 0.0, peak = 0.0;
+  int impacts_seen = 0;
+  while (sim.time() < 0.4) {
+    sim.step();
+    const WallPairList& wl = sim.wall_pairs();
+    double now = 0.0;
+    for (std::size_t k = 0; k < wl.size(); ++k) now = std::max(now, wl.history_of(k)[slot]);
+    if (now == 0.0 && peak > 0.0) {  // a contact ended: it was tested at its peak
+      expected += peak - 0.1;
+      ++impacts_seen;
+      EXPECT_NEAR((*sim.particles().damage())[0], expected, 1e-9 * expected);
+    }
+    peak = now;
+  }
+  EXPECT_GE(impacts_seen, 4);
+}
+
+// The fragments fly apart by their parent's spin; once apart, their contact is gone with its
+// birth overlap, and no force ever acted between them.
+TEST(Grinding, BirthOverlapsEndWhenTheFragmentsPart) {
+  Scene s = impacts(1, 0.05, 3.0, 1.0e9);
+  s.particles[0].velocity = {0.0, 3.0};  // away from the floor: no other contact
+  s.particles[0].position = {0.0, 0.5};
+  s.particles[0].spin = 80.0;
+  // A second, smaller sphere (below minimum_radius: it does not break) strikes it head-on.
+  ParticleSpec hammer;
+  hammer.material = "ore";
+  hammer.radius = 0.04;  // below minimum_radius: it does not break
+  hammer.position = {0.0, 0.7};
+  hammer.velocity = {0.0, -3.0};
+  s.particles.push_back(hammer);
+  Simulation hit(s);
+  while (hit.grinding()->totals().breakages == 0) {
+    hit.step();
+    ASSERT_LT(hit.time(), 0.1);
+  }
+  const std::size_t slot = hit.contacts().history_offset("birth_overlap");
+  bool overlapped = false;
+  for (int k = 0; k < 40000; ++k) {
+    hit.step();
+    bool any = false;
+    for (std::size_t c = 0; c < hit.pairs().size(); ++c)
+      any = any || hit.pairs().history_of(c)[slot] > 0.0;
+    overlapped = overlapped || any;
+    if (overlapped && !any) break;
+  }
+  EXPECT_TRUE(overlapped);
+  for (std::size_t c = 0; c < hit.pairs().size(); ++c)
+    EXPECT_EQ(hit.pairs().history_of(c)[slot], 0.0);
+  // They parted: no pair of fragments overlaps now.
+  const ParticleStore& p = hit.particles();
+  for (std::size_t a = 0; a < p.n_owned(); ++a)
+    for (std::size_t b = a + 1; b < p.n_owned(); ++b)
+      EXPECT_GE(norm(p.pos[a] - p.pos[b]), p.radius[a] + p.radius[b] - 1e-12);
+}
+
+// dt = "auto" is safe from the start for the smallest fragment the run can make.
+TEST(Grinding, AutoStepIsSafeForTheSmallestFragment) {
+  Scene s = impacts(4, 0.05, 1.0, 1.0);
+  s.breakage.minimum_radius = 0.02;
+  const double dt = Simulation(s).dt();
+  Scene small = impacts(4, 0.05, 1.0, 1.0);
+  small.breakage.present = false;
+  small.particles[0].radius = 0.02 / std::cbrt(6.0);
+  EXPECT_DOUBLE_EQ(dt, Simulation(small).dt());
+  EXPECT_LT(dt, Simulation(impacts(4, 0.05, 1.0, 1.0)).dt() * 0.9);
+}
+
+}  // namespace
+}  // namespace dem2d
