@@ -3,6 +3,9 @@
 // inputs/grinding.in (120 steel balls + 60 ore, 1.5 rad/s, feed every 0.25 s, central sieve,
 // breakage from 1 s) run on one core from its fill, four ways:
 //   grinding        the deck as shipped: breakage, feed and sieve;
+//   tests only      the deck with a strength of 1e-30 1/J: every contact is tracked and tested
+//                   but nothing breaks, so the charge stays the one of the next row: the cost of
+//                   the breakage model itself (tracker slots, the scan for tests);
 //   no breakage     the same charge, feed and sieve, without [breakage] (its tracker is not
 //                   compiled into the kernel the scene runs);
 //   charge only     the same charge without [breakage], [feed] and [sieve] (the kernel and the
@@ -97,6 +100,8 @@ int main(int argc, char** argv) {
     }
   }
   const Scene grinding = load_deck(DEM2D_SOURCE_DIR "/inputs/grinding.in");
+  Scene tests_only = grinding;
+  tests_only.breakage.strength = 1e-30;
   Scene no_breakage = grinding;
   no_breakage.breakage.present = false;
   Scene charge = no_breakage;
@@ -107,8 +112,9 @@ int main(int argc, char** argv) {
   std::printf("%-13s %12s %9s %9s %5s %10s %12s %12s\n", "scene", "p-steps/s", "particles",
               "breakages", "fed", "discharged", "mass_error", "energy_res");
   for (const auto& [name, scene] :
-       {std::pair{"grinding", grinding}, std::pair{"no breakage", no_breakage},
-        std::pair{"charge only", charge}, std::pair{"waterfall", waterfall}}) {
+       {std::pair{"grinding", grinding}, std::pair{"tests only", tests_only},
+        std::pair{"no breakage", no_breakage}, std::pair{"charge only", charge},
+        std::pair{"waterfall", waterfall}}) {
     const Row r = measure(name, scene, duration);
     std::printf("%-13s %12.4g %9lld %9lld %5lld %10lld %12.3g %12.3g\n", r.name.c_str(), r.rate,
                 static_cast<long long>(r.particles), static_cast<long long>(r.breakages),

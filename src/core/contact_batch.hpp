@@ -47,24 +47,30 @@ struct BatchColumns {
   Array<std::int32_t> pair;   // index into the list
   Array<std::int32_t> coeff;  // material pair index into the coefficient table
   HistoryColumns history;
+  // The history slots the kernel's model declares: only these columns are sized and copied.
+  std::size_t width = kMaxHistorySlots;
 
   void reserve(std::size_t n) {
     if (pair.size() >= n) return;
-    for (Array<double>* v : self().inputs()) v->resize(n);
+    const auto in = self().inputs();
+    for (std::size_t k = 0; k < used(in.size()); ++k) in[k]->resize(n);
     for (Array<double>* v : self().outputs()) v->resize(n);
-    for (Array<double>& v : history.fresh) v.resize(n);
+    for (std::size_t s = 0; s < width; ++s) history.fresh[s].resize(n);
     pair.resize(n);
     coeff.resize(n);
   }
   // Copy contact `from` into slot `to` (padding).
   void copy(std::size_t to, std::size_t from) {
-    for (Array<double>* v : self().inputs()) (*v)[to] = (*v)[from];
+    const auto in = self().inputs();
+    for (std::size_t k = 0; k < used(in.size()); ++k) (*in[k])[to] = (*in[k])[from];
     pair[to] = pair[from];
     coeff[to] = coeff[from];
   }
 
  private:
   Derived& self() { return static_cast<Derived&>(*this); }
+  // The inputs in use: all but the history columns beyond `width` (they come last).
+  std::size_t used(std::size_t inputs) const { return inputs - kMaxHistorySlots + width; }
 };
 
 struct ContactBatch : BatchColumns<ContactBatch> {

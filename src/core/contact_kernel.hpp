@@ -74,6 +74,7 @@ class Kernel final : public ContactKernel {
     for (int a = 0; a < n_mat_; ++a)
       for (int b = 0; b < n_mat_; ++b) coeffs_.push_back(Model::coeffs(table(a, b), spec));
     if (!coeffs_.empty()) uniform_ = broadcast(0);  // a scene without materials has no contacts
+    b_.width = wb_.width = W;
   }
   std::span<const HistorySlot> history_slots() const override { return slots_; }
 
