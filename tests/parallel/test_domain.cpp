@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <set>
 #include <span>
@@ -350,7 +351,9 @@ Mismatch compare_to_serial(const Simulation& par, const Simulation& ser) {
 }
 
 // Runs the scene serially and in parallel side by side for `steps`, comparing every `every`.
-void expect_same_as_serial(const Scene& scene, int steps, int every) {
+// `check` then looks at the serial run's end state.
+void expect_same_as_serial(const Scene& scene, int steps, int every,
+                           const std::function<void(const Simulation&)>& check = {}) {
   DecompositionOptions opt;
   opt.has_center = scene.drum.present;
   opt.center = scene.drum.center;
@@ -388,6 +391,7 @@ void expect_same_as_serial(const Scene& scene, int steps, int every) {
         "imbalance %.3f\n",
         scene.title.c_str(), steps, static_cast<long long>(checked),
         static_cast<long long>(migrated), domain.stats().partitions, domain.stats().imbalance_work);
+  if (check) check(ser);
 }
 
 Scene thesis_drum(int balls, double speed, int sides) {
@@ -418,6 +422,70 @@ TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
   f.velocity = {0.3, -0.2};
   s.fills.push_back(f);
   expect_same_as_serial(s, 6000, 500);
+}
+
+// Ore breaking all over a drum filled to its centre (where every wedge meets), so that fragments
+// are born across sector boundaries and at the centre, with feed and a sieve at the centre:
+// ids, births, removals and every particle's state the same on every rank count.
+TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
+  Scene s;
+  s.title = "ore breaking, feed and sieve, whole drum, centre filled";
+  s.deck_path = "test_domain";
+  s.materials.push_back(thesis_steel());
+  s.run.gravity = {0.0, 0.0};
+  MaterialSpec ore = thesis_steel();
+  ore.name = "ore";
+  ore.density = 4800.0;
+  ore.youngs_modulus = 6.0e10;
+  ore.shear_modulus = 2.4e10;
+  s.materials.push_back(ore);
+  s.run.dt_auto = true;
+  s.drum.present = true;
+  s.drum.radius = 0.3;
+  s.drum.speed = 6.0;
+  s.drum.sides = 8;
+  s.drum.material = "steel";
+  // Two halves of the drum thrown at each other: head-on collisions along the vertical through
+  // the centre, across the sector boundaries that meet there.
+  for (const double side : {-1.0, 1.0}) {
+    FillSpec f;
+    f.material = "ore";
+    f.count = 80;
+    f.radius_min = 0.008;
+    f.radius_max = 0.016;
+    f.region = FillRegion::kBox;
+    f.box_min = {side < 0 ? -0.26 : 0.005, -0.2};
+    f.box_max = {side < 0 ? -0.005 : 0.26, 0.2};
+    f.velocity = {-1.5 * side, 0.0};
+    s.fills.push_back(f);
+  }
+  s.breakage.present = true;
+  s.breakage.material = "ore";
+  s.breakage.minimum_energy = 1e-6;
+  s.breakage.strength = 1e5;
+  s.breakage.minimum_radius = 0.011;
+  s.feed.present = true;
+  s.feed.material = "ore";
+  s.feed.period = 0.003;
+  s.feed.radius_min = 0.008;
+  s.feed.radius_max = 0.012;
+  s.sieve.present = true;
+  s.sieve.material = "ore";
+  s.sieve.box_min = {-0.05, -0.05};
+  s.sieve.box_max = {0.05, 0.05};
+  s.sieve.aperture = 0.008;
+  const std::size_t initial = static_cast<std::size_t>(Simulation(s).particles().n_owned());
+  expect_same_as_serial(s, 12000, 2000, [initial](const Simulation& ser) {
+    const SeriesRow r = ser.diagnostics();
+    EXPECT_GT(r.breakages, 20);
+    EXPECT_GT(r.fed_count, 3);
+    EXPECT_GT(r.discharged_count, 0);
+    const ParticleStore& p = ser.particles();
+    int near_centre = 0;
+    for (std::size_t k = 0; k < p.n_owned(); ++k)
+      near_centre += p.id[k] >= static_cast<std::int64_t>(initial) && norm(p.pos[k]) < 0.05;
+    EXPECT_GT(near_centre, 0) << "no fragment or fed particle near the centre";
+  });
 }
 
 TEST(Reproducibility, ThesisWaterfallScene) {
