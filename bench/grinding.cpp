@@ -14,14 +14,19 @@
 // Each row: particle-steps per wall second over the steps (the steps only), the particles at
 // the end, breakages, fed and discharged counts, and the two error measures: the mass balance
 // (initial mill mass + fed - mill mass - discharged, over the mill mass, worst row) and the
-// energy balance residual over the drive work at the end. The cost of the grinding code in a
-// scene without ore models is measured against a binary without it by bench/same_physics.sh
-// (old and new binaries run alternately) and docs/performance.md.
+// energy balance residual over the drive work at the end.
 //
-//   grinding [--duration S] [--no-plot] [--results DIR]
+// --baseline OLD_DEM2D: the cost of the grinding code in a scene without ore models. The
+// waterfall deck (3 s) is run by OLD_DEM2D (a binary built before the grinding code, e.g. from
+// commit 048fec3 in a second work tree) and by this build's dem2d, alternately, --pairs times
+// each; the table gives both wall times per pair and the median of the new/old ratios (the
+// machine's drift cancels pair by pair). The two runs' snapshots are compared too.
+//
+//   grinding [--duration S] [--baseline OLD_DEM2D [--pairs N]] [--no-plot] [--results DIR]
 //
 // Writes the table, bench/results/grinding.csv and bench/results/grinding.png (a bar chart of the
 // rates).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -78,6 +83,46 @@ Row measure(const std::string& name, Scene scene, double duration) {
   return row;
 }
 
+// Wall seconds of one shell command (its output discarded); negative when it failed.
+double timed(const std::string& command) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const int status = std::system((command + " > /dev/null 2>&1").c_str());
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return status == 0 ? s : -1.0;
+}
+
+// The waterfall by the old and the new binary, alternately; returns the median new/old ratio.
+double baseline_ratio(const std::string& old_binary, int pairs, const std::string& results) {
+  const std::string deck = DEM2D_SOURCE_DIR "/inputs/waterfall.in";
+  const std::string args = " --quiet " + deck + " --set run.duration=3 --output ";
+  const std::string new_binary = DEM2D_BINARY;
+  std::vector<double> ratios;
+  std::printf("waterfall 3 s, whole process: old binary %s, new %s\n", old_binary.c_str(),
+              new_binary.c_str());
+  std::printf("%5s %10s %10s %8s\n", "pair", "old_s", "new_s", "new/old");
+  for (int k = 0; k < pairs; ++k) {
+    const double t_old = timed(old_binary + args + results + "/baseline_old");
+    const double t_new = timed(new_binary + args + results + "/baseline_new");
+    if (t_old <= 0.0 || t_new <= 0.0) {
+      std::printf("a run failed (old %g s, new %g s)\n", t_old, t_new);
+      return 0.0;
+    }
+    ratios.push_back(t_new / t_old);
+    std::printf("%5d %10.3f %10.3f %8.4f\n", k + 1, t_old, t_new, t_new / t_old);
+  }
+  std::sort(ratios.begin(), ratios.end());
+  const double median = ratios[ratios.size() / 2];
+  const int same =
+      std::system(("/usr/bin/python3 " DEM2D_SOURCE_DIR "/post/h5compare.py " + results +
+                   "/baseline_old/snapshots.h5 " + results + "/baseline_new/snapshots.h5")
+                      .c_str());
+  std::printf("median new/old %.4f (min %.4f, max %.4f)%s\n", median, ratios.front(), ratios.back(),
+              same == 0 ? "" : "; the snapshots DIFFER");
+  std::filesystem::remove_all(results + "/baseline_old");
+  std::filesystem::remove_all(results + "/baseline_new");
+  return median;
+}
+
 }  // namespace
 }  // namespace dem2d
 
@@ -85,17 +130,25 @@ int main(int argc, char** argv) {
   using namespace dem2d;
   double duration = 4.0;
   bool plot = true;
+  std::string baseline;
+  int pairs = 8;
   std::string results = DEM2D_SOURCE_DIR "/bench/results";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--duration" && i + 1 < argc) {
       duration = std::stod(argv[++i]);
+    } else if (a == "--baseline" && i + 1 < argc) {
+      baseline = argv[++i];
+    } else if (a == "--pairs" && i + 1 < argc) {
+      pairs = std::stoi(argv[++i]);
     } else if (a == "--no-plot") {
       plot = false;
     } else if (a == "--results" && i + 1 < argc) {
       results = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: grinding [--duration S] [--no-plot] [--results DIR]\n");
+      std::fprintf(stderr,
+                   "usage: grinding [--duration S] [--baseline OLD_DEM2D [--pairs N]] "
+                   "[--no-plot] [--results DIR]\n");
       return 2;
     }
   }
@@ -134,6 +187,7 @@ int main(int argc, char** argv) {
           << "," << r.discharged << "," << r.mass_error << "," << r.energy_residual << "\n";
   }
   std::printf("wrote %s\n", csv_path.c_str());
+  if (!baseline.empty() && baseline_ratio(baseline, pairs, results) <= 0.0) return 1;
   if (plot) {
     const std::string cmd =
         "/usr/bin/python3 -c \"import csv,matplotlib;matplotlib.use('Agg');"
