@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <numbers>
 
@@ -292,6 +293,81 @@ TEST(Grinding, AutoStepIsSafeForTheSmallestFragment) {
   small.particles[0].radius = 0.02 / std::cbrt(6.0);
   EXPECT_DOUBLE_EQ(dt, Simulation(small).dt());
   EXPECT_LT(dt, Simulation(impacts(4, 0.05, 1.0, 1.0)).dt() * 0.9);
+}
+
+// Fragments at the size limit, run with the auto step: ore just above the smallest breakable
+// radius strikes a floor at 8 m/s under gravity and breaks into fragments down to
+// minimum_radius / 6^(1/3) (six each), which bounce off the floor and off each other in a box. The
+// auto step chosen at the start (from that smallest fragment) keeps every later contact resolved:
+// the overlap stays at its Hertz size, nothing leaves the box and the energy balance holds.
+// With the step the parents alone would get, the same run overlaps more and books worse.
+struct SizeLimitRun {
+  double smallest = 0.0, max_overlap = 0.0, residual = 0.0, dissipated = 0.0, dt = 0.0;
+  std::int64_t breakages = 0, particles = 0;
+};
+
+SizeLimitRun size_limit_run(bool fragments_known_to_dt) {
+  const int n = 16;
+  Scene s = impacts(n, 0.041, 8.0, 1.0e9);
+  s.run.gravity = {0.0, -9.81};
+  s.breakage.minimum_radius = 0.04;
+  s.breakage.fragments_mean = 6.0;  // every break makes 6: all fragments at the size limit
+  s.breakage.fragments_min = 6;
+  const double width = 3.0 * 0.041 * n;
+  for (double x : {-0.041, width}) {
+    WallSpec side;
+    side.from = {x, 0.0};
+    side.to = {x, 2.0};
+    side.material = "ore";
+    s.walls.push_back(side);
+  }
+  if (!fragments_known_to_dt) {  // the parents' step, fixed
+    Scene parents = s;
+    parents.breakage.present = false;
+    s.run.dt_auto = false;
+    s.run.dt = Simulation(parents).dt();
+  }
+  Simulation sim(s);
+  const double b0 = energy_balance(sim.diagnostics());
+  SizeLimitRun out;
+  out.dt = sim.dt();
+  while (sim.time() < 0.3) {
+    sim.step();
+    out.max_overlap = std::max(out.max_overlap, sim.last_totals().max_overlap);
+  }
+  const ParticleStore& p = sim.particles();
+  out.smallest = *std::min_element(p.radius.data(), p.radius.data() + p.n_owned());
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    EXPECT_GT(p.pos[k].y, 0.0) << "particle " << p.id[k] << " below the floor";
+    EXPECT_GT(p.pos[k].x, -0.041) << "particle " << p.id[k] << " through the left wall";
+    EXPECT_LT(p.pos[k].x, width) << "particle " << p.id[k] << " through the right wall";
+  }
+  const SeriesRow end = sim.diagnostics();
+  out.residual = energy_balance(end) - b0;
+  out.dissipated = end.dissipated_energy;
+  out.breakages = end.breakages;
+  out.particles = static_cast<std::int64_t>(p.n_owned());
+  return out;
+}
+
+TEST(Grinding, FragmentsAtTheSizeLimitStayResolvedWithTheAutoStep) {
+  const SizeLimitRun run = size_limit_run(true);
+  const SizeLimitRun coarse = size_limit_run(false);
+  std::printf(
+      "[ size limit ] auto dt %.3e s: %lld breakages, %lld particles, smallest r %.4f m, "
+      "max overlap %.4f r, residual %.2e of dissipated; parents' dt %.3e s: overlap "
+      "%.4f r, residual %.2e\n",
+      run.dt, static_cast<long long>(run.breakages), static_cast<long long>(run.particles),
+      run.smallest, run.max_overlap, run.residual / run.dissipated, coarse.dt, coarse.max_overlap,
+      coarse.residual / coarse.dissipated);
+  EXPECT_EQ(run.breakages, 16);  // every parent broke; fragments are below minimum_radius
+  EXPECT_EQ(run.particles, 6 * 16);
+  EXPECT_NEAR(run.smallest, 0.041 / std::cbrt(6.0), 1e-12);
+  EXPECT_LT(run.max_overlap, 0.02);
+  EXPECT_LT(std::abs(run.residual), 3e-4 * run.dissipated);
+  EXPECT_LT(run.dt, 0.85 * coarse.dt);
+  // The bound tells the two steps apart: the parents' step books 8 times worse (6.6e-4).
+  EXPECT_GT(std::abs(coarse.residual), 3e-4 * coarse.dissipated);
 }
 
 // A feed by mass rate at a given point: the mass fed keeps up with rate x t to within one
