@@ -405,7 +405,9 @@ int main(int argc, char** argv) {
   Options opt;
   app.add_option("INPUT", opt.deck, "input deck (.in, TOML)");
   app.add_flag("--check", opt.check, "validate the deck, print derived quantities, run nothing");
-  app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)");
+  // One KEY=VALUE per --set (repeatable), so that --set may stand before the deck too.
+  app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)")
+      ->allow_extra_args(false);
   app.add_option("--output", opt.output, "output directory (overrides output.directory)");
   app.add_flag("--quiet", opt.quiet, "no progress line");
   bool version = false;

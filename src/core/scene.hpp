@@ -48,6 +48,7 @@ struct RunSpec {
   double duration = 1.0;  // s of simulated time
   double dt = 0.0;        // s; 0 means "auto"
   bool dt_auto = true;
+  std::string dt_where;  // where dt was set, for messages: "deck.in:14:6", "--set run.dt=1e-3"
   IntegratorKind integrator = IntegratorKind::kVerlet;
   double tolerance = 1.0e-6;  // iterative: relative acceleration change (thesis T31)
   int max_passes = 20;        // iterative

@@ -84,7 +84,8 @@ void Simulation::choose_dt() {
   dt_ = scene_.run.dt;
   if (dt_ > scales_.limit_dt && !scene_.run.allow_unsafe_dt) {
     std::ostringstream o;
-    o << scene_.deck_path << ": error: run.dt = " << dt_ << " s is unsafe: it exceeds half of "
+    o << (scene_.run.dt_where.empty() ? scene_.deck_path : scene_.run.dt_where)
+      << ": error: run.dt = " << dt_ << " s is unsafe: it exceeds half of "
       << "the smallest Rayleigh time (" << format_seconds(scales_.rayleigh)
       << ") or Hertz contact time (" << format_seconds(scales_.hertz) << " at "
       << scales_.impact_speed << " m/s); the safe dt is " << scales_.safe_dt

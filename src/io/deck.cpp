@@ -114,6 +114,8 @@ class Diagnostics {
     return value_text(node);
   }
 
+  // Where a value came from: the --set option that made it, else its deck position.
+  std::string where(const toml::node& node) const { return location(node); }
   // At a value or table: the --set option that made it, else its deck position, else the file.
   void error_at(const toml::node& node, std::string_view message) { add(location(node), message); }
   // At a key: the key's own position when it is in the deck.
@@ -1086,6 +1088,7 @@ Scene parse_deck_string(const std::string& text, const std::string& path_for_mes
   Scene scene = DeckParser(root, diag, deck_dir.empty() ? fs::path(".") : deck_dir).parse();
   if (!diag.messages().empty()) throw InputError(std::move(diag.messages()));
   scene.deck_path = path_for_messages;
+  if (const toml::node* dt = root.at_path("run.dt").node()) scene.run.dt_where = diag.where(*dt);
   return scene;
 }
 

@@ -29,6 +29,8 @@ expect() {
 cp "$src/inputs/drop.in" "$tmp/typo.in"
 sed -i 's/^restitution = 0.73/restituion = 0.73/; s/^density = 7800.0/density = -7800.0/' "$tmp/typo.in"
 printf 'title = "x"\n[run\nduration = 1\n' > "$tmp/syntax.in"
+sed 's/^dt = .*/dt = 0.01/' "$src/inputs/drop.in" > "$tmp/unsafe_dt.in"
+grep -q '^dt = 0.01' "$tmp/unsafe_dt.in" || echo "FAIL drop.in has no 'dt =' line to make unsafe"
 cp "$src/inputs/drop.in" "$tmp/model.in"
 sed -i 's/^model = "hertz-mindlin"/model = "hertz"/' "$tmp/model.in"
 
@@ -44,7 +46,9 @@ for np in 1 2; do
   expect "np$np syntax error located" 2 'syntax\.in:2:[0-9]+: error' -- "${run[@]}" "$tmp/syntax.in"
   expect "np$np bad choice lists allowed" 2 'model\.in:[0-9]+:[0-9]+: error: .*"hertz-mindlin"' -- "${run[@]}" "$tmp/model.in"
   expect "np$np bad --set" 2 'did you mean' -- "${run[@]}" "$src/inputs/drop.in" --set run.durration=1
-  expect "np$np unsafe dt names the safe dt" 2 'run\.dt = 0\.01 s is unsafe.*safe dt is' -- "${run[@]}" "$src/inputs/drop.in" --set run.dt=0.01
+  expect "np$np unsafe dt names the option and the safe dt" 2 '^--set run\.dt=0\.01: error: run\.dt = 0\.01 s is unsafe.*safe dt is' -- "${run[@]}" "$src/inputs/drop.in" --set run.dt=0.01
+  expect "np$np unsafe dt in the deck names its line" 2 'unsafe_dt\.in:[0-9]+:[0-9]+: error: run\.dt = 0\.01 s is unsafe' -- "${run[@]}" "$tmp/unsafe_dt.in"
+  expect "np$np --set before the deck" 2 '^--set run\.durration=1: error: unknown key' -- "${run[@]}" --set run.durration=1 "$src/inputs/drop.in"
   expect "np$np unwritable output" 2 "output/x.*cannot write|--output .*error" -- "${run[@]}" "$src/inputs/drop.in" --quiet --output /proc/output/x
 done
 
@@ -52,6 +56,7 @@ done
 expect "check waterfall" 0 'fill fraction: +0\.3840' -- "$dem2d" --check "$src/inputs/waterfall.in"
 expect "check critical speed" 0 'critical speed: +1\.98' -- "$dem2d" --check "$src/inputs/waterfall.in"
 expect "check --set speed" 0 'drum speed: +1\.5000 rad/s' -- "$dem2d" --check "$src/inputs/waterfall.in" --set drum.speed=1.5
+expect "check --set before the deck" 0 'drum speed: +1\.5000 rad/s' -- "$dem2d" --check --set drum.speed=1.5 --set run.duration=2 "$src/inputs/waterfall.in"
 for deck in "$src"/inputs/*.in; do
   expect "check $(basename "$deck")" 0 'the deck is valid' -- "$dem2d" --check "$deck"
 done
