@@ -101,7 +101,9 @@ double baseline_ratio(const std::string& old_binary, int pairs, const std::strin
               new_binary.c_str());
   std::printf("%5s %10s %10s %8s\n", "pair", "old_s", "new_s", "new/old");
   for (int k = 0; k < pairs; ++k) {
+    std::filesystem::remove_all(results + "/baseline_old");  // one folder, one run
     const double t_old = timed(old_binary + args + results + "/baseline_old");
+    std::filesystem::remove_all(results + "/baseline_new");
     const double t_new = timed(new_binary + args + results + "/baseline_new");
     if (t_old <= 0.0 || t_new <= 0.0) {
       std::printf("a run failed (old %g s, new %g s)\n", t_old, t_new);

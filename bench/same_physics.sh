@@ -19,6 +19,7 @@ src=$(cd "$(dirname "$0")/.." && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 run() {
   local bin=$1 deck=$2 dir=$3
+  rm -rf "$dir"  # one folder, one run: a rerun into the same OUT_DIR starts afresh
   if [ "$np" -gt 1 ]; then
     mpirun -np "$np" --oversubscribe "$bin" --quiet --output "$dir" "$deck" > "$dir.log" 2>&1
   else

@@ -40,6 +40,7 @@ struct Options {
   std::string output;
   bool check = false;
   bool quiet = false;
+  bool overwrite = false;
 };
 
 int g_rank = 0;
@@ -154,15 +155,17 @@ DecompositionOptions decomposition_of(const Scene& scene) {
 
 // Collective. An output directory that cannot be written is bad input (exit 2), named by its
 // key; a write that fails later (disk full) stays an I/O failure (exit 4).
-void prepare_output(const Options& opt, const Scene& scene) {
+// One folder, one run: the output directory is created, checked and locked for this run (a
+// folder in use, or holding another run's output without --overwrite, is bad input: exit 2).
+OutputLock prepare_output(const Options& opt, const Scene& scene) {
   const std::string& dir = scene.output.directory;
   try {
-    prepare_output_directory(MPI_COMM_WORLD, dir);
+    return claim_output_directory(MPI_COMM_WORLD, dir, opt.overwrite);
   } catch (const IoError& e) {
     const std::string source = opt.output.empty()
                                    ? scene.deck_path + ": error: output.directory = '" + dir + "': "
                                    : "--output " + opt.output + ": error: ";
-    throw InputError(source + e.what() + "; give a directory you can write to");
+    throw InputError(source + e.what());
   }
 }
 
@@ -363,7 +366,7 @@ int run(const Options& opt) {
   Simulation sim(scene, &domain);
   const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
   const OutputSpec& out = scene.output;
-  prepare_output(opt, scene);
+  const OutputLock lock = prepare_output(opt, scene);
   SeriesOutput series(scene);
   SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
   if (!opt.quiet)
@@ -410,6 +413,9 @@ int main(int argc, char** argv) {
       ->allow_extra_args(false);
   app.add_option("--output", opt.output, "output directory (overrides output.directory)");
   app.add_flag("--quiet", opt.quiet, "no progress line");
+  app.add_flag("--overwrite", opt.overwrite,
+               "replace the output of an earlier run in the output directory (never a running "
+               "one's)");
   bool version = false;
   app.add_flag("--version", version, "print the version and exit");
 

@@ -1,13 +1,17 @@
 #include "io/output_dir.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "parallel/comm.hpp"
@@ -37,16 +41,98 @@ std::string check_directory(const fs::path& dir) {
   return {};
 }
 
+std::string this_host() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return "unknown";
+  return name;
+}
+
+// Who holds a lock: "HOST PID" as the lock file says it.
+struct LockHolder {
+  std::string host;
+  long pid = 0;
+  bool running_here = false;  // on this host and the process is alive
+};
+
+LockHolder read_lock(const fs::path& lock) {
+  LockHolder h;
+  std::ifstream in(lock);
+  in >> h.host >> h.pid;
+  if (h.host == this_host() && h.pid > 0)
+    h.running_here = ::kill(static_cast<pid_t>(h.pid), 0) == 0 || errno == EPERM;
+  return h;
+}
+
+// The claim's verdict on rank 0: empty when the folder is this run's now.
+std::string claim(const fs::path& dir, const std::string& shown, bool overwrite, bool& locked) {
+  if (const std::string reason = check_directory(dir); !reason.empty())
+    return fmt::format(
+        "cannot write to output directory '{}': {}; give a directory you can "
+        "write to",
+        shown, reason);
+  const fs::path lock = dir / kOutputLockName;
+  std::error_code ec;
+  std::vector<std::string> found;
+  if (fs::exists(lock, ec)) {
+    const LockHolder h = read_lock(lock);
+    if (h.running_here)
+      return fmt::format(
+          "output directory '{}' is in use by a dem2d run that is still running "
+          "(pid {} on host {}); give this run its own folder with --output DIR",
+          shown, h.pid, h.host);
+    found.push_back(h.host == this_host()
+                        ? fmt::format("{} of a run that did not end (pid {} on host {})",
+                                      kOutputLockName, h.pid, h.host)
+                        : fmt::format("{} of a run on host {} (pid {}), which may still be "
+                                      "running: this host cannot tell",
+                                      kOutputLockName, h.host, h.pid));
+  }
+  for (const char* name : kRunOutputs)
+    if (fs::exists(dir / name, ec)) found.emplace_back(name);
+  if (!found.empty() && !overwrite)
+    return fmt::format(
+        "output directory '{}' holds another run's output ({}); give this run a "
+        "new folder with --output DIR, or --overwrite to replace that output",
+        shown, fmt::join(found, ", "));
+  if (overwrite) {
+    fs::remove(lock, ec);
+    for (const char* name : kRunOutputs) fs::remove(dir / name, ec);
+  }
+  const int fd = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0 && errno == EEXIST)
+    return fmt::format(
+        "output directory '{}' was claimed by another dem2d run starting at the "
+        "same time; give this run its own folder with --output DIR",
+        shown);
+  if (fd < 0)
+    return fmt::format("cannot write to output directory '{}': {}", shown, std::strerror(errno));
+  const std::string text = fmt::format("{} {}\n", this_host(), ::getpid());
+  const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  ::close(fd);
+  locked = true;
+  if (!written) return fmt::format("cannot write to output directory '{}': {}", shown, "disk full");
+  return {};
+}
+
 }  // namespace
 
-void prepare_output_directory(MPI_Comm comm, const std::string& dir) {
-  std::string error;
+OutputLock::~OutputLock() {
+  if (path_.empty()) return;
+  std::error_code ec;
+  fs::remove(path_, ec);
+}
+
+OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, bool overwrite) {
+  std::string error, lock_path;
+  const fs::path path = dir.empty() ? fs::path(".") : fs::path(dir);
   if (mpi::rank(comm) == 0) {
-    const std::string reason = check_directory(dir.empty() ? fs::path(".") : fs::path(dir));
-    if (!reason.empty())
-      error = fmt::format("cannot write to output directory '{}': {}", dir, reason);
+    bool locked = false;
+    error = claim(path, dir, overwrite, locked);
+    if (locked) lock_path = (path / kOutputLockName).string();
   }
+  OutputLock lock(lock_path);  // removed again if any rank fails below
   mpi::agree_on_failure<IoError>(comm, error);
+  return lock;
 }
 
 }  // namespace dem2d

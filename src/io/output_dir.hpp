@@ -1,5 +1,6 @@
-// The output directory of a run: created and checked once, before anything is written, by
-// all ranks together (style.md item 9).
+// The output directory of a run: created, checked and claimed once, before anything is
+// written, by all ranks together (style.md item 9). One folder, one run: a run claims its
+// folder with a lock file naming its host and pid, removed when the run ends.
 #pragma once
 
 #include <string>
@@ -8,9 +9,35 @@
 
 namespace dem2d {
 
-// Collective. Rank 0 creates `dir` (with its parents) and checks that a file can be created
-// and removed in it; the outcome is broadcast. On failure every rank throws IoError
-// "cannot write to output directory 'DIR': REASON" with the same text.
-void prepare_output_directory(MPI_Comm comm, const std::string& dir);
+// The lock a run holds on its output directory; rank 0 removes the file when it goes.
+class OutputLock {
+ public:
+  OutputLock() = default;
+  explicit OutputLock(std::string path) : path_(std::move(path)) {}
+  OutputLock(OutputLock&& o) noexcept : path_(std::move(o.path_)) { o.path_.clear(); }
+  OutputLock& operator=(OutputLock&&) = delete;
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+  ~OutputLock();
+
+ private:
+  std::string path_;  // empty on ranks other than 0
+};
+
+// The files a run writes into its directory, and the lock's name.
+inline constexpr const char* kOutputLockName = ".dem2d.lock";
+inline constexpr const char* kRunOutputs[] = {"run.json",      "series.csv",  "snapshots.h5",
+                                              "snapshots.xmf", "product.csv", "breakages.csv"};
+
+// Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and
+// removed in it, and claims it for this run:
+//   - a folder locked by a dem2d run that is still running (same host, live pid) is refused,
+//     --overwrite or not;
+//   - a folder holding another run's output (a file of kRunOutputs, or the lock of a run that
+//     has ended without removing it) is refused unless `overwrite`, which removes those files;
+//   - then the lock is created (exclusively: of two runs starting together one is refused).
+// The outcome is broadcast: on failure every rank throws IoError with the same text (the
+// reason and what to do: "give ... --output DIR", "--overwrite").
+OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, bool overwrite);
 
 }  // namespace dem2d

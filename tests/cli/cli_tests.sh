@@ -70,6 +70,29 @@ done
 head -1 "$tmp/drop/series.csv" | grep -q '^time,step,particles,contacts,kinetic_energy,rotational_energy,potential_energy,elastic_energy,dissipated_energy,drum_torque,drum_power' \
   && pass "series.csv columns" || fail "series.csv columns"
 grep -q '"ranks": 2' "$tmp/drop/run.json" && pass "run.json records 2 ranks" || fail "run.json ranks"
+[ -e "$tmp/drop/.dem2d.lock" ] && fail "the run left its lock" || pass "the run released its lock"
+
+# One folder, one run: a second run into the same folder is refused (exit 2, on every rank,
+# the first run's output untouched) unless --overwrite; a folder in use is refused even then.
+sum_before=$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")
+for np in 1 2; do
+  expect "np$np second run into one folder refused" 2 "^--output $tmp/drop: error: output directory '$tmp/drop' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf\); give this run a new folder with --output DIR, or --overwrite" -- \
+    mpirun -np "$np" --oversubscribe "$dem2d" "$src/inputs/drop.in" --set run.duration=0.05 --output "$tmp/drop"
+done
+[ "$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")" = "$sum_before" ] \
+  && pass "refused runs left the first run's output as it was" || fail "a refused run touched the first run's output"
+expect "deck's folder refused names the key" 2 "drop\.in: error: output\.directory = '.*': output directory .* holds another run's output" -- \
+  "$dem2d" --quiet "$src/inputs/drop.in" --set run.duration=0.05 --set "output.directory=$tmp/drop"
+expect "--overwrite replaces the output" 0 'done: 0.05 s simulated' -- "$dem2d" "$src/inputs/drop.in" \
+  --set run.duration=0.05 --output "$tmp/drop" --overwrite
+grep -q '^0.05' <(tail -1 "$tmp/drop/series.csv" | cut -c1-4) && [ "$(grep -c '^' "$tmp/drop/series.csv")" -lt 100 ] \
+  && pass "series.csv holds the new run only" || fail "series.csv mixes two runs"
+"$dem2d" --quiet "$src/inputs/waterfall.in" --set run.duration=20 --output "$tmp/busy" > /dev/null 2>&1 &
+busy=$!
+for _ in $(seq 50); do [ -e "$tmp/busy/.dem2d.lock" ] && break; sleep 0.1; done
+expect "folder in use refused even with --overwrite" 2 "output directory '$tmp/busy' is in use by a dem2d run that is still running \(pid $busy on host" -- \
+  "$dem2d" "$src/inputs/drop.in" --output "$tmp/busy" --overwrite
+kill "$busy"; wait "$busy" 2> /dev/null
 
 # A run that blows up: exit 3, the step and particle ids named, a last snapshot, no NaN written.
 expect "unstable run exits 3" 3 'unstable at step [0-9]+.*particle [0-9]+ (and particle [0-9]+|moves [0-9.e+-]+ times its radius).*safe dt is' -- "$dem2d" \

@@ -6,6 +6,7 @@
 #include <hdf5.h>
 #include <mpi.h>
 #include <stdlib.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cmath>
@@ -741,30 +742,82 @@ TEST(SeriesWriter, FullDiskIsAnIoError) {
 
 // --- output directory -------------------------------------------------------------------
 
-TEST(OutputDirectory, CreatesNestedDirectoriesAndLeavesNoProbe) {
+std::string host() {
+  char name[256] = {};
+  ::gethostname(name, sizeof name - 1);
+  return name;
+}
+
+TEST(OutputDirectory, CreatesNestedDirectoriesAndLocksThemWhileTheRunLasts) {
   ScratchDir dir;
   const std::string out = dir / "a/b/c";
-  prepare_output_directory(MPI_COMM_WORLD, out);
+  const std::string lock = out + "/" + kOutputLockName;
+  {
+    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, false);
+    MPI_Barrier(MPI_COMM_WORLD);
+    EXPECT_TRUE(fs::is_directory(out));
+    EXPECT_TRUE(fs::exists(lock));  // and nothing else: the write probe is gone
+    EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 1);
+    MPI_Barrier(MPI_COMM_WORLD);  // every rank looked before rank 0 probes again
+    // This process is running: a second claim is refused, --overwrite or not.
+    for (const bool overwrite : {false, true})
+      expect_same_io_error_everywhere(
+          [&] { claim_output_directory(MPI_COMM_WORLD, out, overwrite); },
+          "output directory '" + out + "' is in use by a dem2d run that is still running (pid ");
+    EXPECT_TRUE(fs::exists(lock));  // the refused claims left the holder's lock alone
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
   MPI_Barrier(MPI_COMM_WORLD);
-  EXPECT_TRUE(fs::is_directory(out));
-  EXPECT_TRUE(fs::is_empty(out));
-  MPI_Barrier(MPI_COMM_WORLD);                    // every rank looked before rank 0 probes again
-  prepare_output_directory(MPI_COMM_WORLD, out);  // existing: fine
+  EXPECT_FALSE(fs::exists(lock));  // released when the run ends
+  MPI_Barrier(MPI_COMM_WORLD);
+  claim_output_directory(MPI_COMM_WORLD, out, false);  // an empty folder: fine again
+}
+
+TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
+  ScratchDir dir;
+  const std::string out = dir / "run";
+  if (comm_rank() == 0) {
+    fs::create_directories(out);
+    std::ofstream(out + "/series.csv") << "time\n";
+    std::ofstream(out + "/snapshots.h5") << "x";
+    // The lock of a run killed without a chance to remove it: no process has pid 2^22 + 1.
+    std::ofstream(out + "/" + kOutputLockName) << host() << " 4194305\n";
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_same_io_error_everywhere(
+      [&] { claim_output_directory(MPI_COMM_WORLD, out, false); },
+      "output directory '" + out + "' holds another run's output (" + kOutputLockName +
+          " of a run that did not end (pid 4194305 on host " + host() +
+          "), series.csv, "
+          "snapshots.h5); give this run a new folder with --output DIR, or --overwrite to "
+          "replace that output");
+  MPI_Barrier(MPI_COMM_WORLD);
+  EXPECT_TRUE(fs::exists(out + "/series.csv"));  // refused: nothing touched
+  {
+    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, true);
+    MPI_Barrier(MPI_COMM_WORLD);
+    EXPECT_FALSE(fs::exists(out + "/series.csv"));  // the old output is gone, not mixed in
+    EXPECT_FALSE(fs::exists(out + "/snapshots.h5"));
+    EXPECT_TRUE(fs::exists(out + "/" + kOutputLockName));
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
 }
 
 TEST(OutputDirectory, UnwritableIsTheSameIoErrorOnEveryRank) {
   ScratchDir dir;
   expect_same_io_error_everywhere(
-      [] { prepare_output_directory(MPI_COMM_WORLD, "/proc/dem2d_no"); },
+      [] { claim_output_directory(MPI_COMM_WORLD, "/proc/dem2d_no", false); },
       "cannot write to output directory '/proc/dem2d_no': ");
   if (comm_rank() == 0) std::ofstream(dir / "plain_file") << "x";
   MPI_Barrier(MPI_COMM_WORLD);
   const std::string under_file = dir / "plain_file/sub";
-  expect_same_io_error_everywhere([&] { prepare_output_directory(MPI_COMM_WORLD, under_file); },
-                                  "cannot write to output directory '" + under_file + "': ");
+  expect_same_io_error_everywhere(
+      [&] { claim_output_directory(MPI_COMM_WORLD, under_file, false); },
+      "cannot write to output directory '" + under_file + "': ");
   const std::string file_itself = dir / "plain_file";
-  expect_same_io_error_everywhere([&] { prepare_output_directory(MPI_COMM_WORLD, file_itself); },
-                                  "cannot write to output directory '" + file_itself + "': ");
+  expect_same_io_error_everywhere(
+      [&] { claim_output_directory(MPI_COMM_WORLD, file_itself, false); },
+      "cannot write to output directory '" + file_itself + "': ");
 }
 
 }  // namespace
