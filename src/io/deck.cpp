@@ -22,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <span>
 #include <sstream>
@@ -618,6 +619,7 @@ class DeckParser {
     // [[particle]] before [[fill]]: file fills append their particles after the explicit ones.
     const auto particles = root.table_array("particle");
     for (std::size_t i = 0; i < particles.size(); ++i) read_particle(*particles[i], i);
+    if (diag_.messages().empty()) check_placement(particles);
     const auto fills = root.table_array("fill");
     for (std::size_t i = 0; i < fills.size(); ++i) read_fill(*fills[i], i);
     const auto walls = root.table_array("wall");
@@ -868,6 +870,72 @@ class DeckParser {
       r.invalid("height", fmt::format("must be < drum.radius = {}", *radius));
     }
     scene_.drum.lifters.push_back(std::move(lifter));
+  }
+
+  // Where the deck's [[particle]] tables put their particles (before step 1; docs/input.md,
+  // "Placement"): inside the drum clear of its shell, and apart from each other. A particle
+  // whose disc reaches the shell, or overlaps another by more than kPlacementOverlap of the
+  // smaller radius (a resting Hertz contact overlaps well under 1 %), is bad input.
+  static constexpr double kPlacementOverlap = 0.05;
+  void check_placement(const std::vector<const toml::table*>& tables) {
+    const std::size_t n = std::min(tables.size(), scene_.particles.size());
+    for (std::size_t i = 0; i < n; ++i) check_in_drum(*tables[i], i);
+    std::vector<std::size_t> order(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = i;
+    const auto x = [&](std::size_t i) { return scene_.particles[i].position.x; };
+    std::sort(order.begin(), order.end(), [&](auto a, auto b) { return x(a) < x(b); });
+    double r_max = 0.0;
+    for (std::size_t i = 0; i < n; ++i) r_max = std::max(r_max, scene_.particles[i].radius);
+    for (std::size_t a = 0; a < n; ++a)  // a sweep along x: pairs closer than 2 r_max in x
+      for (std::size_t b = a + 1; b < n && x(order[b]) - x(order[a]) < 2.0 * r_max; ++b)
+        check_apart(tables, std::min(order[a], order[b]), std::max(order[a], order[b]));
+  }
+
+  // Inside the drum's circle or polygon (its vertices on the radius, rotated by drum.angle),
+  // by the particle's clearance from the nearest side.
+  void check_in_drum(const toml::table& table, std::size_t i) {
+    const DrumSpec& d = scene_.drum;
+    const ParticleSpec& p = scene_.particles[i];
+    if (!d.present || !table.get("position")) return;
+    const Vec2 rel = p.position - d.center;
+    double clearance = d.radius - norm(rel);
+    if (d.sides >= 3) {
+      const double step = 2.0 * std::numbers::pi / d.sides;
+      const double apothem = d.radius * std::cos(0.5 * step);
+      for (int k = 0; k < d.sides; ++k) {
+        const double phi = d.angle + (k + 0.5) * step;
+        clearance = std::min(clearance, apothem - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
+      }
+    }
+    if (clearance >= p.radius) return;
+    const TableReader r(diag_, table, deck::kParticle, i);
+    r.invalid(
+        "position",
+        fmt::format("the particle (radius {:g} m) {} the drum (radius {:g} m about [{:g}, "
+                    "{:g}]{}); place it at least its radius inside the shell",
+                    p.radius, clearance <= -p.radius ? "lies outside" : "straddles the shell of",
+                    d.radius, d.center.x, d.center.y,
+                    d.sides >= 3 ? fmt::format(", {} sides", d.sides) : std::string()));
+  }
+
+  void check_apart(const std::vector<const toml::table*>& tables, std::size_t i, std::size_t j) {
+    const ParticleSpec& p = scene_.particles[i];
+    const ParticleSpec& q = scene_.particles[j];
+    if (!tables[j]->get("position")) return;
+    const double gap = norm(q.position - p.position);
+    const double overlap = p.radius + q.radius - gap;
+    const double smaller = std::min(p.radius, q.radius);
+    if (overlap <= kPlacementOverlap * smaller) return;
+    const TableReader r(diag_, *tables[j], deck::kParticle, j);
+    r.invalid(
+        "position",
+        gap <= 1e-9 * smaller
+            ? fmt::format("coincides with particle[{}] (line {}); give each particle its "
+                          "own place",
+                          i, p.source_line)
+            : fmt::format("overlaps particle[{}] (line {}) by {:.3g} % of the smaller "
+                          "radius; at most {:g} % is allowed at the start",
+                          i, p.source_line, 100.0 * overlap / smaller, 100.0 * kPlacementOverlap));
   }
 
   void read_particle(const toml::table& table, std::size_t index) {

@@ -29,6 +29,7 @@ expect() {
 cp "$src/inputs/drop.in" "$tmp/typo.in"
 sed -i 's/^restitution = 0.73/restituion = 0.73/; s/^density = 7800.0/density = -7800.0/' "$tmp/typo.in"
 printf 'title = "x"\n[run\nduration = 1\n' > "$tmp/syntax.in"
+{ cat "$src/inputs/waterfall.in"; printf '\n[[particle]]\nmaterial = "steel"\nradius = 0.1\nposition = [0.0, 3.0]\n'; } > "$tmp/outside.in"
 sed 's/^dt = .*/dt = 0.01/' "$src/inputs/drop.in" > "$tmp/unsafe_dt.in"
 grep -q '^dt = 0.01' "$tmp/unsafe_dt.in" || echo "FAIL drop.in has no 'dt =' line to make unsafe"
 cp "$src/inputs/drop.in" "$tmp/model.in"
@@ -48,6 +49,7 @@ for np in 1 2; do
   expect "np$np bad --set" 2 'did you mean' -- "${run[@]}" "$src/inputs/drop.in" --set run.durration=1
   expect "np$np unsafe dt names the option and the safe dt" 2 '^--set run\.dt=0\.01: error: run\.dt = 0\.01 s is unsafe.*safe dt is' -- "${run[@]}" "$src/inputs/drop.in" --set run.dt=0.01
   expect "np$np unsafe dt in the deck names its line" 2 'unsafe_dt\.in:[0-9]+:[0-9]+: error: run\.dt = 0\.01 s is unsafe' -- "${run[@]}" "$tmp/unsafe_dt.in"
+  expect "np$np particle outside the drum" 2 "outside\.in:[0-9]+:[0-9]+: error: particle\[0\]\.position = \[0\.0, 3\.0\]: the particle \(radius 0\.1 m\) lies outside the drum" -- "${run[@]}" "$tmp/outside.in"
   expect "np$np --set before the deck" 2 '^--set run\.durration=1: error: unknown key' -- "${run[@]}" --set run.durration=1 "$src/inputs/drop.in"
   expect "np$np unwritable output" 2 "output/x.*cannot write|--output .*error" -- "${run[@]}" "$src/inputs/drop.in" --quiet --output /proc/output/x
 done

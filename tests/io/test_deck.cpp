@@ -1,6 +1,8 @@
 // Deck reader and writer (src/io/deck.*, particle_csv.*, run_json.*): every key resolved,
 // defaults, each kind of error with its exact location, --set overrides, CSV packings, the
 // resolved deck read back to the same values, run.json.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -470,6 +472,53 @@ TEST(DeckErrors, TomlSyntaxErrorHasItsPosition) {
   EXPECT_EQ(twice[0],
             "deck.in:3:12: error: Error while parsing key-value pair: cannot redefine "
             "existing floating-point 'duration'");
+}
+
+// Placement before step 1: a particle outside the drum, straddling its polygonal shell,
+// coinciding with another or overlapping it by more than 5 % of the smaller radius is bad input
+// at its position; a particle inside the circle but outside the polygon is caught by the sides.
+TEST(DeckErrors, ParticlesOutsideTheDrumOrOnEachOtherAreRefused) {
+  std::string deck = R"([[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+
+[drum]
+radius = 1.0
+sides = 8
+material = "steel"
+)";
+  for (const char* xy : {"[0.0, 0.0]", "[0.0, 0.0]", "[0.15, 0.0]", "[0.0, -0.9]", "[0.0, 3.0]",
+                         "[0.7853, 0.3253]", "[0.0, 0.5]", "[0.0, 0.6985]"})
+    deck += fmt::format("[[particle]]\nmaterial = \"steel\"\nradius = 0.1\nposition = {}\n", xy);
+  const auto messages = deck_errors(deck);
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:17:12: error: particle[1].position = [0.0, 0.0]: coincides with "
+                          "particle[0] (line 10); give each particle its own place"));
+  EXPECT_TRUE(
+      has_message(messages,
+                  "deck.in:21:12: error: particle[2].position = [0.15, 0.0]: overlaps particle[0] "
+                  "(line 10) by 50 % of the smaller radius; at most 5 % is allowed at the start"));
+  EXPECT_TRUE(has_message(
+      messages,
+      "deck.in:25:12: error: particle[3].position = [0.0, -0.9]: the particle (radius "
+      "0.1 m) straddles the shell of the drum (radius 1 m about [0, 0], 8 sides); place "
+      "it at least its radius inside the shell"));
+  EXPECT_TRUE(
+      has_message(messages,
+                  "deck.in:29:12: error: particle[4].position = [0.0, 3.0]: the particle (radius "
+                  "0.1 m) lies outside the drum (radius 1 m about [0, 0], 8 sides); place it at "
+                  "least its radius inside the shell"));
+  // particle[5] is 0.85 from the centre towards the middle of a side: 0.15 inside the circle
+  // but 0.074 from the side (apothem 0.924), less than its radius.
+  EXPECT_TRUE(
+      has_message(messages,
+                  "deck.in:33:12: error: particle[5].position = [0.7853, 0.3253]: the particle "
+                  "(radius 0.1 m) straddles the shell of the drum (radius 1 m about [0, 0], 8 "
+                  "sides); place it at least its radius inside the shell"));
+  // particle[6] at [0, 0.5] and particle[7] 0.1985 from it overlap by 0.75 %: a resting contact,
+  // accepted. particle[2] overlaps both particle[0] and particle[1].
+  EXPECT_EQ(messages.size(), 6u) << fmt::format("{}", fmt::join(messages, "\n"));
 }
 
 TEST(DeckErrors, OutOfRangeValue) {
@@ -1074,7 +1123,7 @@ material = "ore"
 [contact]
 model = "linear"
 [drum]
-radius = 0.3
+radius = 1.0
 speed_rpm = 17.3
 material = "steel"
 )",
