@@ -176,7 +176,7 @@ class SeriesOutput {
   explicit SeriesOutput(const Scene& scene) {
     std::string error;
     try {
-      file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/series.csv",
+      file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/" + kSeriesFile,
                                              scene.run.integrator == IntegratorKind::kIterative,
                                              g_rank == 0, is_ore_scene(scene));
     } catch (const IoError& e) {
@@ -379,7 +379,7 @@ int run(const Options& opt) {
   if (!advance(sim, scene, series, snapshots, progress, n_global)) return kExitUnstable;
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   const RunInfo info = run_info(sim, domain, scene, n_global, wall);
-  if (g_rank == 0) write_run_json(out.directory + "/run.json", scene, info);
+  if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
   if (!opt.quiet)
     say(fmt_double("done: %.4g s simulated", sim.time()) +
         fmt_double(" in %.3g s of wall time", wall) +

@@ -878,8 +878,9 @@ class DeckParser {
   // smaller radius (a resting Hertz contact overlaps well under 1 %), is bad input.
   static constexpr double kPlacementOverlap = 0.05;
   void check_placement(const std::vector<const toml::table*>& tables) {
-    const std::size_t n = std::min(tables.size(), scene_.particles.size());
-    for (std::size_t i = 0; i < n; ++i) check_in_drum(*tables[i], i);
+    const std::size_t n = tables.size();  // one particle per table, every key valid
+    const std::vector<Vec2> sides = side_normals();
+    for (std::size_t i = 0; i < n; ++i) check_in_drum(*tables[i], i, sides);
     std::vector<std::size_t> order(n);
     for (std::size_t i = 0; i < n; ++i) order[i] = i;
     const auto x = [&](std::size_t i) { return scene_.particles[i].position.x; };
@@ -891,22 +892,29 @@ class DeckParser {
         check_apart(tables, std::min(order[a], order[b]), std::max(order[a], order[b]));
   }
 
-  // Inside the drum's circle or polygon (its vertices on the radius, rotated by drum.angle),
-  // by the particle's clearance from the nearest side.
-  void check_in_drum(const toml::table& table, std::size_t i) {
+  // The outward normals of the drum polygon's sides (its vertices on the radius, rotated by
+  // drum.angle); none for a circle or no drum.
+  std::vector<Vec2> side_normals() const {
+    const DrumSpec& d = scene_.drum;
+    std::vector<Vec2> normals;
+    if (!d.present || d.sides < 3) return normals;
+    const double step = 2.0 * std::numbers::pi / d.sides;
+    for (int k = 0; k < d.sides; ++k) {
+      const double phi = d.angle + (k + 0.5) * step;
+      normals.push_back({std::cos(phi), std::sin(phi)});
+    }
+    return normals;
+  }
+
+  // Inside the drum's circle or polygon, by the particle's clearance from the nearest side.
+  void check_in_drum(const toml::table& table, std::size_t i, const std::vector<Vec2>& sides) {
     const DrumSpec& d = scene_.drum;
     const ParticleSpec& p = scene_.particles[i];
-    if (!d.present || !table.get("position")) return;
+    if (!d.present) return;
     const Vec2 rel = p.position - d.center;
     double clearance = d.radius - norm(rel);
-    if (d.sides >= 3) {
-      const double step = 2.0 * std::numbers::pi / d.sides;
-      const double apothem = d.radius * std::cos(0.5 * step);
-      for (int k = 0; k < d.sides; ++k) {
-        const double phi = d.angle + (k + 0.5) * step;
-        clearance = std::min(clearance, apothem - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
-      }
-    }
+    const double apothem = sides.empty() ? 0.0 : d.radius * std::cos(std::numbers::pi / d.sides);
+    for (const Vec2& normal : sides) clearance = std::min(clearance, apothem - dot(rel, normal));
     if (clearance >= p.radius) return;
     const TableReader r(diag_, table, deck::kParticle, i);
     r.invalid(
@@ -921,7 +929,6 @@ class DeckParser {
   void check_apart(const std::vector<const toml::table*>& tables, std::size_t i, std::size_t j) {
     const ParticleSpec& p = scene_.particles[i];
     const ParticleSpec& q = scene_.particles[j];
-    if (!tables[j]->get("position")) return;
     const double gap = norm(q.position - p.position);
     const double overlap = p.radius + q.radius - gap;
     const double smaller = std::min(p.radius, q.radius);

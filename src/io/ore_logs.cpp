@@ -8,11 +8,13 @@
 #include <iterator>
 
 #include "core/errors.hpp"
+#include "io/output_dir.hpp"
 
 namespace dem2d {
 
 OreLogs::OreLogs(const std::string& directory, bool active)
-    : product_path_(directory + "/product.csv"), breakages_path_(directory + "/breakages.csv") {
+    : product_path_(directory + "/" + kProductFile),
+      breakages_path_(directory + "/" + kBreakagesFile) {
   if (!active) return;
   for (auto [file, path, header] :
        {std::tuple{&product_, &product_path_, "time,id,radius,mass\n"},

@@ -54,33 +54,54 @@ struct LockHolder {
   bool running_here = false;  // on this host and the process is alive
 };
 
-LockHolder read_lock(const fs::path& lock) {
+LockHolder read_lock(const fs::path& lock, const std::string& host) {
   LockHolder h;
   std::ifstream in(lock);
   in >> h.host >> h.pid;
-  if (h.host == this_host() && h.pid > 0)
+  if (h.host == host && h.pid > 0)
     h.running_here = ::kill(static_cast<pid_t>(h.pid), 0) == 0 || errno == EPERM;
   return h;
 }
 
-// The claim's verdict on rank 0: empty when the folder is this run's now.
-std::string claim(const fs::path& dir, const std::string& shown, bool overwrite, bool& locked) {
+// Takes the lock (exclusively: of two runs starting together one is refused); returns the reason
+// it could not, empty once the lock file holds "HOST PID".
+std::string take_lock(const fs::path& lock, const std::string& shown, const std::string& host) {
+  const int fd = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0 && errno == EEXIST)
+    return fmt::format(
+        "output directory '{}' was claimed by another dem2d run starting at the "
+        "same time; give this run its own folder with --output DIR",
+        shown);
+  if (fd < 0)
+    return fmt::format("cannot write to output directory '{}': {}", shown, std::strerror(errno));
+  const std::string text = fmt::format("{} {}\n", host, ::getpid());
+  const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
+  ::close(fd);
+  if (written) return {};
+  std::error_code ec;
+  fs::remove(lock, ec);
+  return fmt::format("cannot write to output directory '{}': {}", shown, "disk full");
+}
+
+// The claim's verdict on rank 0: empty when the folder is this run's now (its lock taken).
+std::string claim(const fs::path& dir, const std::string& shown, bool overwrite) {
   if (const std::string reason = check_directory(dir); !reason.empty())
     return fmt::format(
         "cannot write to output directory '{}': {}; give a directory you can "
         "write to",
         shown, reason);
+  const std::string host = this_host();
   const fs::path lock = dir / kOutputLockName;
   std::error_code ec;
   std::vector<std::string> found;
   if (fs::exists(lock, ec)) {
-    const LockHolder h = read_lock(lock);
+    const LockHolder h = read_lock(lock, host);
     if (h.running_here)
       return fmt::format(
           "output directory '{}' is in use by a dem2d run that is still running "
           "(pid {} on host {}); give this run its own folder with --output DIR",
           shown, h.pid, h.host);
-    found.push_back(h.host == this_host()
+    found.push_back(h.host == host
                         ? fmt::format("{} of a run that did not end (pid {} on host {})",
                                       kOutputLockName, h.pid, h.host)
                         : fmt::format("{} of a run on host {} (pid {}), which may still be "
@@ -98,20 +119,7 @@ std::string claim(const fs::path& dir, const std::string& shown, bool overwrite,
     fs::remove(lock, ec);
     for (const char* name : kRunOutputs) fs::remove(dir / name, ec);
   }
-  const int fd = ::open(lock.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-  if (fd < 0 && errno == EEXIST)
-    return fmt::format(
-        "output directory '{}' was claimed by another dem2d run starting at the "
-        "same time; give this run its own folder with --output DIR",
-        shown);
-  if (fd < 0)
-    return fmt::format("cannot write to output directory '{}': {}", shown, std::strerror(errno));
-  const std::string text = fmt::format("{} {}\n", this_host(), ::getpid());
-  const bool written = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
-  ::close(fd);
-  locked = true;
-  if (!written) return fmt::format("cannot write to output directory '{}': {}", shown, "disk full");
-  return {};
+  return take_lock(lock, shown, host);
 }
 
 }  // namespace
@@ -126,9 +134,8 @@ OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, bool ov
   std::string error, lock_path;
   const fs::path path = dir.empty() ? fs::path(".") : fs::path(dir);
   if (mpi::rank(comm) == 0) {
-    bool locked = false;
-    error = claim(path, dir, overwrite, locked);
-    if (locked) lock_path = (path / kOutputLockName).string();
+    error = claim(path, dir, overwrite);
+    if (error.empty()) lock_path = (path / kOutputLockName).string();
   }
   OutputLock lock(lock_path);  // removed again if any rank fails below
   mpi::agree_on_failure<IoError>(comm, error);

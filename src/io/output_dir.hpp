@@ -24,10 +24,17 @@ class OutputLock {
   std::string path_;  // empty on ranks other than 0
 };
 
-// The files a run writes into its directory, and the lock's name.
+// The files a run writes into its directory (their writers take the names from here), and the
+// lock's name.
+inline constexpr const char* kRunJsonFile = "run.json";
+inline constexpr const char* kSeriesFile = "series.csv";
+inline constexpr const char* kSnapshotsFile = "snapshots.h5";
+inline constexpr const char* kXdmfFile = "snapshots.xmf";
+inline constexpr const char* kProductFile = "product.csv";
+inline constexpr const char* kBreakagesFile = "breakages.csv";
+inline constexpr const char* kRunOutputs[] = {kRunJsonFile, kSeriesFile,  kSnapshotsFile,
+                                              kXdmfFile,    kProductFile, kBreakagesFile};
 inline constexpr const char* kOutputLockName = ".dem2d.lock";
-inline constexpr const char* kRunOutputs[] = {"run.json",      "series.csv",  "snapshots.h5",
-                                              "snapshots.xmf", "product.csv", "breakages.csv"};
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and
 // removed in it, and claims it for this run:

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
+#include "io/output_dir.hpp"
 
 namespace dem2d {
 namespace {
@@ -146,8 +147,8 @@ std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles) {
 SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
                                const std::vector<MaterialSpec>& materials)
     : comm_(comm),
-      h5_path_((fs::path(directory) / "snapshots.h5").string()),
-      xdmf_path_((fs::path(directory) / "snapshots.xmf").string()) {
+      h5_path_((fs::path(directory) / kSnapshotsFile).string()),
+      xdmf_path_((fs::path(directory) / kXdmfFile).string()) {
   rank_ = mpi::rank(comm_);
   // Rank 0 tries the path first with plain stdio: the usual failures (no such directory, not
   // writable) give a clear reason, and all ranks learn of them before the collective create.
