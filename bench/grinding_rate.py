@@ -32,24 +32,19 @@ import os
 import subprocess
 import sys
 import tempfile
+import tomllib
 from concurrent.futures import ThreadPoolExecutor
 
 G = 9.81
 
 
 def deck_value(deck, table, key):
-    """A number from a deck's [table] (first occurrence), enough for drum.radius and breakage.*."""
-    section = None
-    with open(deck, encoding="utf-8") as f:
-        for line in f:
-            line = line.split("#", 1)[0].strip()
-            if line.startswith("["):
-                section = line.strip("[]")
-            elif section == table and "=" in line:
-                k, v = (s.strip() for s in line.split("=", 1))
-                if k == key:
-                    return float(v)
-    raise SystemExit(f"grinding_rate: {deck} has no {table}.{key}")
+    """A number from a deck's [table] (the deck is TOML)."""
+    with open(deck, "rb") as f:
+        value = tomllib.load(f).get(table, {}).get(key)
+    if value is None:
+        raise SystemExit(f"grinding_rate: {deck} has no {table}.{key}")
+    return float(value)
 
 
 def read_csv(path):
