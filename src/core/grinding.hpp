@@ -58,6 +58,15 @@ struct ProductRecord {
   double radius = 0.0, mass = 0.0;
 };
 
+// What a checkpoint keeps of the grinding (the rest is the scene's): the id counter, the feed's
+// wait, the counts, and this rank's share of the energies fed and discharged.
+struct GrindingState {
+  std::int64_t next_id = 0, births_from = -1;
+  double next_feed_try = 0.0;
+  GrindingTotals totals;
+  double rank_fed_energy = 0.0, rank_discharged_energy = 0.0;
+};
+
 class Grinding {
  public:
   // The next free id is one above the largest id of the particles placed (all ranks).
@@ -82,6 +91,18 @@ class Grinding {
   std::vector<BreakageRecord> take_breakages();
   std::vector<ProductRecord> take_product();
   std::int64_t next_id() const { return next_id_; }
+  // Checkpoints: the state after a step (records already taken), and the same put back.
+  GrindingState state() const {
+    return {next_id_, births_from_, next_feed_try_, totals_, fed_energy_, discharged_energy_};
+  }
+  void restore(const GrindingState& s) {
+    next_id_ = s.next_id;
+    births_from_ = s.births_from;
+    next_feed_try_ = s.next_feed_try;
+    totals_ = s.totals;
+    fed_energy_ = s.rank_fed_energy;
+    discharged_energy_ = s.rank_discharged_energy;
+  }
   // The ore: the breakage material, else the feed's, else the sieve's.
   int ore_material() const {
     return break_material_ >= 0 ? break_material_

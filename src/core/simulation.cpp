@@ -28,16 +28,40 @@ std::string format_seconds(double s) {
 
 }  // namespace
 
-Simulation::Simulation(const Scene& scene, Domain* domain)
+Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* resume)
     : scene_(prepared(scene)),
       domain_(domain ? domain : &serial_domain_),
       walls_(scene_),
       contacts_(scene_) {
   if (scene_.breakage.present) particles_.enable_damage();
-  place_particles(scene_, walls_, particles_);
+  if (resume)
+    load_particles(*resume);
+  else
+    place_particles(scene_, walls_, particles_);
   scales_ = time_scales(scene_, particles_);
-  choose_dt();
+  if (resume)
+    dt_ = resume->state.dt;
+  else
+    choose_dt();
+  if (!resume) validate_start(scene_, particles_, dt_);  // bad input before step 1
   integrator_ = make_integrator(scene_.run, dt_, scene_.run.gravity);
+  set_up_lists();
+  if (resume) {
+    resume_from(*resume);
+  } else {
+    rebuild();
+    refresh_forces();
+  }
+  backup_.save(particles_, time_, step_);
+  builds_at_backup_ = contacts_.builds();
+  if (scene_.breakage.present || scene_.feed.present || scene_.sieve.present)
+    grinding_ = std::make_unique<Grinding>(scene_, particles_, *domain_);
+  if (resume && grinding_) grinding_->restore(resume->state.grinding);
+}
+
+// The skin and the halo, then every rank keeps its own particles (every rank placed or loaded
+// the same ones).
+void Simulation::set_up_lists() {
   double r_min = std::numeric_limits<double>::max(), r_max = 0.0;
   for (std::size_t k = 0; k < particles_.size(); ++k) {
     r_min = std::min(r_min, particles_.radius[k]);
@@ -45,19 +69,89 @@ Simulation::Simulation(const Scene& scene, Domain* domain)
   }
   rebuilds_ = RebuildMonitor(scene_.run.skin >= 0.0 ? scene_.run.skin
                                                     : (particles_.size() ? 0.4 * r_min : 0.0));
-  // Every rank placed the same particles; from here on each keeps its own (parallel runs).
   // A pair interacts within r_i + r_j + skin, so a rank needs the particles within
   // 2 r_max + skin of its region.
   if (scene_.feed.present) r_max = std::max(r_max, scene_.feed.radius_max);
   halo_width_ = 2.0 * r_max + rebuilds_.skin();
   ghost_fields_ = {&particles_.pos, &particles_.vel, &particles_.omega};
+}
+
+// Every particle of the checkpoint, in id order (whatever order the ranks wrote them in).
+void Simulation::load_particles(const Resumption& resume) {
+  const std::vector<FieldBase*>& fields = particles_.fields();
+  if (resume.columns.size() != fields.size())
+    throw std::logic_error("Simulation: a resumption needs one column per particle field");
+  const std::size_t n = resume.n_particles;
+  particles_.add_owned(n);
+  for (std::size_t f = 0; f < fields.size(); ++f) {
+    if (resume.columns[f].size() != n * fields[f]->bytes_per_item())
+      throw std::logic_error("Simulation: resumption column " + fields[f]->name() +
+                             " has the wrong size");
+    fields[f]->unpack_items(0, n, resume.columns[f].data());
+  }
+  std::vector<std::size_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = k;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return particles_.id[a] < particles_.id[b]; });
+  particles_.permute(order);
+}
+
+// The time, step, dt and lists of the checkpoint (its skin and halo: they were chosen from the
+// particles at the start), the histories of this rank's particles, and the ledger. The forces
+// and accelerations are the checkpoint's (the velocity-dependent ones were evaluated at Verlet's
+// half-step velocity, which a new evaluation could not reproduce).
+void Simulation::resume_from(const Resumption& resume) {
+  const RunState& s = resume.state;
+  time_ = s.time;
+  step_ = s.step;
+  walls_.update(time_);
+  rebuilds_ = RebuildMonitor(s.skin);
+  halo_width_ = s.halo_width;
   domain_->adopt(particles_, halo_width_);
+  std::vector<std::int64_t> mine(particles_.id.data(), particles_.id.data() + particles_.n_owned());
+  std::sort(mine.begin(), mine.end());
+  const auto owned = [&](std::int64_t id) {
+    return std::binary_search(mine.begin(), mine.end(), id);
+  };
+  HistoryRecords records(resume.histories.width());
+  for (std::size_t k = 0; k < resume.histories.size(); ++k)
+    if (owned(resume.histories.a(k)) ||
+        (resume.histories.b(k) >= 0 && owned(resume.histories.b(k))))
+      records.push_back(resume.histories.a(k), resume.histories.b(k), resume.histories.values(k));
+  records.sort_unique();
+  contacts_.adopt(records);
   rebuild();
-  refresh_forces();
-  backup_.save(particles_, time_, step_);
-  builds_at_backup_ = contacts_.builds();
-  if (scene_.breakage.present || scene_.feed.present || scene_.sieve.present)
-    grinding_ = std::make_unique<Grinding>(scene_, particles_, *domain_);
+  dissipated_ = s.rank_dissipated;
+  drive_work_ = s.rank_drive_work;
+  balance0_ = s.balance0;
+  motion0_ = s.motion0;
+  potential0_ = s.potential0;
+  energy_floor_ = s.energy_floor;
+  baseline_taken_ = s.baseline_taken;
+  integrator_->passes() = s.passes;
+  builds_before_ = s.neighbor_builds - contacts_.builds();
+  guards_ = s.guards;
+}
+
+RunState Simulation::run_state() const {
+  RunState s;
+  s.time = time_;
+  s.step = step_;
+  s.dt = dt_;
+  s.skin = rebuilds_.skin();
+  s.halo_width = halo_width_;
+  s.rank_dissipated = dissipated_;
+  s.rank_drive_work = drive_work_;
+  s.baseline_taken = baseline_taken_;
+  s.balance0 = balance0_;
+  s.motion0 = motion0_;
+  s.potential0 = potential0_;
+  s.energy_floor = energy_floor_;
+  s.passes = integrator_->passes();
+  s.neighbor_builds = neighbor_builds();
+  s.guards = guards_;
+  if (grinding_) s.grinding = grinding_->state();
+  return s;
 }
 
 // The energy balance as the first step starts (after whatever the caller set by hand), and

@@ -27,6 +27,7 @@
 #include "core/materials.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
+#include "core/run_state.hpp"
 #include "core/scene.hpp"
 #include "core/state_backup.hpp"
 #include "core/time_scales.hpp"
@@ -66,18 +67,27 @@ constexpr const char* guard_name(Guard g) {
 }
 constexpr bool guard_may_warn(Guard g) { return g != Guard::kFinite && g != Guard::kMotion; }
 
-// A guard that fired in a run with run.guards = "warn" (the run went on).
-struct GuardRecord {
-  std::string kind;        // guard_name: "overlap", "energy" or "passes"
-  std::int64_t count = 0;  // steps (energy: checks, every kEnergyCheckSteps) at which it fired
-  std::string first;       // the message of the first time, as the stopping error would say it
+// A run resumed from a checkpoint (io/checkpoint.hpp reads it): the run's state (its rank_*
+// shares already this rank's), every particle of the run with all its registered fields, and
+// the contact histories.
+struct Resumption {
+  RunState state;
+  std::size_t n_particles = 0;
+  // One column per field of the particle store's registry, in registry order: n_particles
+  // items of bytes_per_item() bytes each (the particles in any order, the same in every column).
+  std::vector<std::vector<std::byte>> columns;
+  HistoryRecords histories;  // every rank's, in any order, duplicates allowed
 };
 
 class Simulation final : private StepStages {
  public:
   // Builds walls and particles from the scene and evaluates the initial forces. Throws
   // InputError for an impossible placement or an unsafe dt.
-  explicit Simulation(const Scene& scene, Domain* domain = nullptr);
+  // With `resume`, the particles, histories and state are the checkpoint's instead, and the
+  // run continues exactly where it stopped: the next step() is the one the interrupted run
+  // would have taken (core/run_state.hpp says what is rebuilt rather than restored).
+  explicit Simulation(const Scene& scene, Domain* domain = nullptr,
+                      const Resumption* resume = nullptr);
 
   void step();
   void run_until(double t_end);
@@ -99,7 +109,7 @@ class Simulation final : private StepStages {
   const PairTable& pair_table() const { return contacts_.materials(); }
   const PairList& pairs() const { return contacts_.pairs(); }
   const WallPairList& wall_pairs() const { return contacts_.wall_pairs(); }
-  std::int64_t neighbor_builds() const { return contacts_.builds(); }
+  std::int64_t neighbor_builds() const { return builds_before_ + contacts_.builds(); }
   std::int64_t passes_total() const { return integrator_->passes().total; }
   std::int64_t unconverged_steps() const { return integrator_->passes().unconverged_steps; }
   int last_passes() const { return integrator_->passes().last; }
@@ -110,6 +120,10 @@ class Simulation final : private StepStages {
   // Ore scenes ([breakage], [feed] or [sieve]): breakage, feed and sieve; nullptr otherwise.
   Grinding* grinding() { return grinding_.get(); }
   const Grinding* grinding() const { return grinding_.get(); }
+
+  // What a checkpoint holds besides the particles: this rank's state and committed histories.
+  RunState run_state() const;
+  HistoryRecords histories() const { return contacts_.records(); }
 
   // Force a neighbour-list rebuild (after particles were moved or added by hand).
   void rebuild() override;
@@ -129,6 +143,10 @@ class Simulation final : private StepStages {
   void commit(double dt, double late_loss) override;
 
   void choose_dt();
+  void set_up_lists();
+  // The resuming constructor's part: particles, histories and state from the checkpoint.
+  void load_particles(const Resumption& resume);
+  void resume_from(const Resumption& resume);
   // After a committed step of an ore scene: breakage, sieve and feed; when the population
   // changed, the lists are rebuilt, births excluded, forces evaluated at the new state and the
   // energy the change released booked as dissipated (collective).
@@ -166,6 +184,7 @@ class Simulation final : private StepStages {
   // The energy balance at the start, and the energy then in motion and in the springs.
   double balance0_ = 0.0, motion0_ = 0.0, potential0_ = 0.0, energy_floor_ = 0.0;
   bool baseline_taken_ = false;
+  std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   // Last known good state, saved every 1000 steps and after every rebuild.
   StateBackup backup_;
   std::int64_t builds_at_backup_ = 0;
