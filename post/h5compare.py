@@ -2,6 +2,7 @@
 """Compare two dem2d snapshots.h5 files snapshot by snapshot, particles matched by id.
 
     post/h5compare.py A/snapshots.h5 B/snapshots.h5 [--atol 0] [--show 10] [--allow-added]
+                      [--by-step]
 
 Within each snapshot both files' particles are sorted by id, so runs on different rank counts
 (whose files hold the particles in a different order) compare equal when the physics is the
@@ -9,6 +10,9 @@ same. Compared: the number and names of snapshots, their time and step attribute
 ids, every per-particle dataset (id, material, position, velocity, angle, spin, radius: whatever
 the files hold; a dataset in one file only is a difference) and the /materials table. The
 datasets' unit and doc attributes and /xdmf (ParaView helper data) are not compared.
+With --by-step, snapshots are paired by their step attribute instead of their names: a run
+that was interrupted (which wrote a last snapshot where it stopped) and restarted compares
+with the uninterrupted run, the extra snapshot allowed by --allow-added.
 
 Exit status: 0 when the files are bit-identical (or, with --atol, every floating-point value
 is within atol and everything else is identical); 1 otherwise, after printing the first
@@ -135,6 +139,23 @@ def compare_materials(fa, fb, atol, report):
         compare_arrays("/materials", field, a, b, None, atol, report)
 
 
+def paired_snapshots(fa, fb, by_step, report):
+    """The (name in the first, name in the second) snapshot pairs to compare."""
+    def keyed(f):
+        names = sorted(f["snapshots"].keys()) if "snapshots" in f else []
+        return {(int(f["snapshots"][n].attrs["step"]) if by_step else n): n for n in names}
+    ka, kb = keyed(fa), keyed(fb)
+    only_a = sorted(set(ka) - set(kb))
+    only_b = sorted(set(kb) - set(ka))
+    what = "steps" if by_step else "names"
+    if only_a or (only_b and not (by_step and report.allow_added)):
+        report.differ(f"/snapshots: {len(ka)} snapshots vs {len(kb)}; "
+                      f"{what} only in the first: {only_a[:5]}, only in the second: {only_b[:5]}")
+    elif only_b:
+        report.added.add(f"snapshots at steps {only_b[:5]}")
+    return [(ka[k], kb[k]) for k in sorted(ka) if k in kb]
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("first", help="a snapshots.h5")
@@ -143,8 +164,10 @@ def main(argv=None):
                         help="accept floating-point differences up to this (default 0: bit-identical)")
     parser.add_argument("--show", type=int, default=10, help="differences to print (default 10)")
     parser.add_argument("--allow-added", action="store_true",
-                        help="per-particle datasets only in the second file (a newer dem2d that writes "
-                             "more) are listed, not counted as differences; every common one must match")
+                        help="per-particle datasets (and, with --by-step, snapshots) only in the second "
+                             "file are listed, not counted as differences; every common one must match")
+    parser.add_argument("--by-step", action="store_true",
+                        help="pair snapshots by their step attribute, not by their names")
     args = parser.parse_args(argv)
     try:
         fa = h5py.File(args.first, "r")
@@ -155,15 +178,10 @@ def main(argv=None):
     report = Report(args.show, args.allow_added)
     with fa, fb:
         compare_materials(fa, fb, args.atol, report)
-        sa = sorted(fa["snapshots"].keys()) if "snapshots" in fa else []
-        sb = sorted(fb["snapshots"].keys()) if "snapshots" in fb else []
-        if sa != sb:
-            report.differ(f"/snapshots: {len(sa)} snapshots vs {len(sb)}; "
-                          f"only in the first: {sorted(set(sa) - set(sb))[:5]}, "
-                          f"only in the second: {sorted(set(sb) - set(sa))[:5]}")
-        common = [n for n in sa if n in set(sb)]
-        for name in common:
-            compare_snapshot(name, fa["snapshots"][name], fb["snapshots"][name], args.atol, report)
+        common = paired_snapshots(fa, fb, args.by_step, report)
+        for name_a, name_b in common:
+            compare_snapshot(name_a, fa["snapshots"][name_a], fb["snapshots"][name_b], args.atol,
+                             report)
     if report.differences == 0:
         what = "bit-identical" if args.atol == 0 else f"identical within atol = {args.atol:g}"
         added = f"; datasets only in the second file: {', '.join(sorted(report.added))}" if report.added else ""

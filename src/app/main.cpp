@@ -1,16 +1,19 @@
 // dem2d: command line, wiring and exit codes (interface.md). Everything else lives in the
 // libraries: the deck and outputs in src/io, the physics in src/core, MPI in src/parallel.
 //
-// Exit status: 0 success, 2 bad input or usage, 3 the run became unstable, 4 an I/O failure.
+// Exit status: 0 success, 2 bad input or usage, 3 the run became unstable, 4 an I/O failure,
+// 5 interrupted by SIGINT or SIGTERM (a checkpoint to resume from was written).
 // Every rank parses and validates the same deck, so every rank reaches the same verdict and
 // exits with the same status; rank 0 alone prints.
 #include <mpi.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <memory>
 #include <numbers>
@@ -20,6 +23,7 @@
 
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
+#include "io/checkpoint.hpp"
 #include "io/deck.hpp"
 #include "io/ore_logs.hpp"
 #include "io/output_dir.hpp"
@@ -38,6 +42,7 @@ struct Options {
   std::string deck;
   std::vector<std::string> sets;
   std::string output;
+  std::string restart;  // a checkpoint.h5 to continue from
   bool check = false;
   bool quiet = false;
   bool overwrite = false;
@@ -107,8 +112,9 @@ void print_check(const Simulation& sim) {
 
 class Progress {
  public:
-  Progress(bool quiet, double duration, double interval)
-      : quiet_(quiet),
+  Progress(bool quiet, double duration, double interval, std::int64_t first_step)
+      : first_step_(first_step),
+        quiet_(quiet),
         tty_(isatty(STDERR_FILENO) != 0),
         duration_(duration),
         interval_(interval),
@@ -121,8 +127,10 @@ class Progress {
     if (!final_line && since < (tty_ ? 0.5 : interval_)) return;
     last_ = now;
     const double wall = std::chrono::duration<double>(now - start_).count();
-    const double rate = wall > 0 ? static_cast<double>(n_particles) * sim.step_count() / wall : 0;
-    const double frac = sim.time() / duration_;
+    const double steps = static_cast<double>(sim.step_count() - first_step_);
+    const double rate = wall > 0 ? static_cast<double>(n_particles) * steps / wall : 0;
+    const double t0 = static_cast<double>(first_step_) * sim.dt();
+    const double frac = (sim.time() - t0) / (duration_ - t0);
     const double eta = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
     char line[256];
     std::snprintf(line, sizeof line,
@@ -137,6 +145,7 @@ class Progress {
   }
 
  private:
+  std::int64_t first_step_;
   bool quiet_, tty_;
   double duration_, interval_;
   Clock::time_point start_, last_;
@@ -160,10 +169,15 @@ DecompositionOptions decomposition_of(const Scene& scene) {
 OutputLock prepare_output(const Options& opt, const Scene& scene) {
   const std::string& dir = scene.output.directory;
   try {
-    return claim_output_directory(MPI_COMM_WORLD, dir, opt.overwrite);
+    const Claim how = !opt.restart.empty() ? Claim::kContinue
+                      : opt.overwrite      ? Claim::kOverwrite
+                                           : Claim::kNew;
+    return claim_output_directory(MPI_COMM_WORLD, dir, how);
   } catch (const IoError& e) {
+    const auto at = scene.where.find("output.directory");  // its line, or the --set
+    const std::string deck_at = at != scene.where.end() ? at->second : scene.deck_path;
     const std::string source = opt.output.empty()
-                                   ? scene.deck_path + ": error: output.directory = '" + dir + "': "
+                                   ? deck_at + ": error: output.directory = '" + dir + "': "
                                    : "--output " + opt.output + ": error: ";
     throw InputError(source + e.what());
   }
@@ -173,12 +187,14 @@ OutputLock prepare_output(const Options& opt, const Scene& scene) {
 // stops every rank with the same message instead of leaving the others in a collective.
 class SeriesOutput {
  public:
-  explicit SeriesOutput(const Scene& scene) {
+  // `resumed`: a restart, which continues the file after the checkpoint's step.
+  SeriesOutput(const Scene& scene, const Simulation& sim, bool resumed) {
     std::string error;
     try {
       file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/" + kSeriesFile,
                                              scene.run.integrator == IntegratorKind::kIterative,
-                                             g_rank == 0, is_ore_scene(scene));
+                                             g_rank == 0, is_ore_scene(scene),
+                                             resumed ? sim.step_count() : -1);
     } catch (const IoError& e) {
       error = e.what();
     }
@@ -202,11 +218,12 @@ class SeriesOutput {
 // gathered (as 64-bit words) and rank 0 appends them; a write failure stops every rank alike.
 class OreOutput {
  public:
-  explicit OreOutput(const Scene& scene) {
+  OreOutput(const Scene& scene, const Simulation& sim, bool resumed) {
     if (!is_ore_scene(scene)) return;
     std::string error;
     try {
-      logs_ = std::make_unique<OreLogs>(scene.output.directory, g_rank == 0);
+      logs_ = std::make_unique<OreLogs>(scene.output.directory, g_rank == 0,
+                                        resumed ? sim.time() : -1.0);
     } catch (const IoError& e) {
       error = e.what();
     }
@@ -258,68 +275,156 @@ class OreOutput {
   std::unique_ptr<OreLogs> logs_;
 };
 
-// The time loop with its outputs: series rows and snapshots at their intervals, the first and
-// last state always. Returns false when the run became unstable, after writing a last
-// snapshot and reporting it.
-bool advance(Simulation& sim, const Scene& scene, SeriesOutput& series, SnapshotWriter& snapshots,
-             Progress& progress, std::int64_t n_global) {
-  OreOutput ore(scene);
-  const OutputSpec& out = scene.output;
-  const double dt = sim.dt();
-  const auto at_multiple = [dt](double t, double interval) {
+// SIGINT and SIGTERM (mpirun passes SIGTERM on to every rank) ask the run to stop. The flag
+// is read every kStopPollSteps steps in one reduction, so every rank stops after the same
+// step; the run then writes its checkpoint, last snapshot and run.json and exits with
+// kExitInterrupted. The handler resets itself: a second signal ends the process at once (the
+// checkpoint on disk is then the previous one, whole).
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int signo) { g_stop_signal = signo; }
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+constexpr std::int64_t kStopPollSteps = 100;
+
+enum class Ending { kFinished, kUnstable, kInterrupted };
+
+// The time loop with its outputs: series rows, snapshots and checkpoints at their intervals,
+// the first state (not on a restart: the interrupted run wrote it) and the last one always.
+class RunLoop {
+ public:
+  RunLoop(Simulation& sim, const Scene& scene, Domain& domain, SeriesOutput& series,
+          SnapshotWriter& snapshots, bool resumed)
+      : sim_(sim),
+        scene_(scene),
+        domain_(domain),
+        series_(series),
+        snapshots_(snapshots),
+        ore_(scene, sim, resumed),
+        resumed_(resumed),
+        last_checkpoint_(Clock::now()) {}
+  Ending run(Progress& progress, std::int64_t n_global);
+  // The signal that stopped the run (kInterrupted).
+  int stop_signal() const { return stop_signal_; }
+
+ private:
+  bool at_multiple(double t, double interval) const {
     if (interval <= 0.0) return false;
     const double k = std::round(t / interval);
-    return std::abs(t - k * interval) < 0.5 * dt;
-  };
-  double last_snapshot_time = -1.0;
-  const auto snapshot = [&] {
-    snapshots.write(sim.particles(), sim.time(), sim.step_count());
-    last_snapshot_time = sim.time();
-  };
-  series.write(sim.diagnostics());
-  sim.reset_pass_window();
-  if (out.snapshot_interval > 0) snapshot();
-  std::size_t guards_told = 0;  // run.guards = "warn": each kind is told when it first fires
+    return std::abs(t - k * interval) < 0.5 * sim_.dt();
+  }
+  void snapshot() {
+    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    last_snapshot_time_ = sim_.time();
+  }
+  void after_step();
+  // The logs' records up to now first: a restart keeps the rows up to the checkpoint's time.
+  void checkpoint() {
+    ore_.write(sim_);
+    write_checkpoint(MPI_COMM_WORLD, scene_.output.directory + "/" + kCheckpointFile, sim_);
+    last_checkpoint_ = Clock::now();
+    checkpoint_step_ = sim_.step_count();
+  }
+  // The poll: a stop signal on any rank, and rank 0's clock for output.checkpoint_minutes.
+  bool stop_requested();
+  Ending finish(Ending ending);
+
+  Simulation& sim_;
+  const Scene& scene_;
+  Domain& domain_;
+  SeriesOutput& series_;
+  SnapshotWriter& snapshots_;
+  OreOutput ore_;
+  bool resumed_;
+  Clock::time_point last_checkpoint_;
+  double last_snapshot_time_ = -1.0;
+  std::int64_t checkpoint_step_ = -1;  // the step of the last checkpoint written
+  std::size_t guards_told_ = 0;        // run.guards = "warn": each kind is told when it first fires
+  int stop_signal_ = 0;
+};
+
+Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
+  const OutputSpec& out = scene_.output;
+  if (!resumed_) {
+    series_.write(sim_.diagnostics());
+    sim_.reset_pass_window();
+    if (out.snapshot_interval > 0) snapshot();
+  }
   try {
-    while (sim.time() + 0.5 * dt < scene.run.duration) {
-      sim.step();
-      for (; guards_told < sim.guard_records().size(); ++guards_told)
-        say(scene.deck_path + ": warning: " + sim.guard_records()[guards_told].first +
-                " (run.guards = \"warn\": the run goes on)\n",
-            stderr);
-      if (at_multiple(sim.time(), out.series_interval)) {
-        series.write(sim.diagnostics());
-        ore.write(sim);
-        sim.reset_pass_window();
-      }
-      if (at_multiple(sim.time(), out.snapshot_interval)) snapshot();
-      progress.update(sim, n_global);
+    while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
+      sim_.step();
+      after_step();
+      if (sim_.step_count() % kStopPollSteps == 0 && stop_requested())
+        return finish(Ending::kInterrupted);
+      progress.update(sim_, n_global);
     }
   } catch (const UnstableError& e) {
-    ore.write(sim);
-    snapshots.write(sim.particles(), sim.time(), sim.step_count());
-    say(scene.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
-            "/snapshots.h5\n",
+    ore_.write(sim_);
+    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    say(scene_.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
+            "/" + kSnapshotsFile + "\n",
         stderr);
-    return false;
+    return Ending::kUnstable;
   }
-  if (last_snapshot_time != sim.time()) snapshot();
-  if (!at_multiple(sim.time(), out.series_interval)) series.write(sim.diagnostics());
-  ore.write(sim);
-  progress.update(sim, n_global, true);
-  return true;
+  progress.update(sim_, n_global, true);
+  return finish(Ending::kFinished);
+}
+
+void RunLoop::after_step() {
+  const OutputSpec& out = scene_.output;
+  for (; guards_told_ < sim_.guard_records().size(); ++guards_told_)
+    say(scene_.deck_path + ": warning: " + sim_.guard_records()[guards_told_].first +
+            " (run.guards = \"warn\": the run goes on)\n",
+        stderr);
+  if (at_multiple(sim_.time(), out.series_interval)) {
+    series_.write(sim_.diagnostics());
+    ore_.write(sim_);
+    sim_.reset_pass_window();
+  }
+  if (at_multiple(sim_.time(), out.snapshot_interval)) snapshot();
+  if (at_multiple(sim_.time(), out.checkpoint_interval)) checkpoint();
+}
+
+bool RunLoop::stop_requested() {
+  const double minutes = scene_.output.checkpoint_minutes;
+  double flags[2] = {static_cast<double>(g_stop_signal), 0.0};
+  if (g_rank == 0 && minutes > 0.0 &&
+      std::chrono::duration<double>(Clock::now() - last_checkpoint_).count() >= 60.0 * minutes)
+    flags[1] = 1.0;
+  domain_.max(flags);
+  if (flags[1] > 0.0 && flags[0] == 0.0) checkpoint();
+  stop_signal_ = static_cast<int>(flags[0]);
+  return stop_signal_ != 0;
+}
+
+// The last state: a snapshot (unless this step's was written), the series row (not when
+// interrupted: the restart writes the rows from here on, as the whole run would have), the
+// logs, and the checkpoint, always.
+Ending RunLoop::finish(Ending ending) {
+  const OutputSpec& out = scene_.output;
+  if (last_snapshot_time_ != sim_.time()) snapshot();
+  if (ending == Ending::kFinished && !at_multiple(sim_.time(), out.series_interval))
+    series_.write(sim_.diagnostics());
+  if (checkpoint_step_ != sim_.step_count()) checkpoint();
+  return ending;
 }
 
 // Collective (the decomposition's per-rank figures are gathered): what run.json records.
+// `steps_here`: the steps this process took (a restart continues the step count).
 RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
-                 std::int64_t n_global, double wall) {
+                 std::int64_t n_global, double wall, std::int64_t steps_here) {
   RunInfo info;
   info.version = DEM2D_VERSION;
   info.ranks = g_size;
   info.wall_time_s = wall;
   info.steps = sim.step_count();
   info.particle_steps_per_second =
-      wall > 0 ? static_cast<double>(n_global) * sim.step_count() / wall : 0.0;
+      wall > 0 ? static_cast<double>(n_global) * static_cast<double>(steps_here) / wall : 0.0;
   info.dt = sim.dt();
   info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
   if (scene.run.integrator == IntegratorKind::kIterative) {
@@ -353,37 +458,51 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   return info;
 }
 
-int run(const Options& opt) {
-  Scene scene = load_deck(opt.deck, opt.sets);
-  if (!opt.output.empty()) scene.output.directory = opt.output;
-  if (opt.check) {
-    // Every rank evaluates the whole scene alike; rank 0 prints.
-    const Simulation whole(scene);
-    print_check(whole);
-    return kExitOk;
-  }
-  MpiDomain domain(MPI_COMM_WORLD, decomposition_of(scene));
-  Simulation sim(scene, &domain);
-  const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
-  const OutputSpec& out = scene.output;
-  const OutputLock lock = prepare_output(opt, scene);
-  SeriesOutput series(scene);
-  SnapshotWriter snapshots(MPI_COMM_WORLD, out.directory, scene.materials);
-  if (!opt.quiet)
-    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(n_global) +
-        " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
-        (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory + "\n");
+// The simulation: a new run, or --restart's checkpoint continued (every rank reads it).
+std::unique_ptr<Simulation> make_simulation(const Options& opt, const Scene& scene,
+                                            MpiDomain& domain) {
+  if (opt.restart.empty()) return std::make_unique<Simulation>(scene, &domain);
+  const Resumption r = read_checkpoint(MPI_COMM_WORLD, opt.restart, scene);
+  if (r.state.time + 0.5 * r.state.dt >= scene.run.duration)
+    throw InputError(scene.deck_path + ": error: --restart " + opt.restart +
+                     fmt_double(": the checkpoint is at t = %.10g s,", r.state.time) +
+                     fmt_double(" at or past run.duration = %.10g s: nothing to run; give a "
+                                "longer duration, e.g. --set run.duration=...",
+                                scene.run.duration));
+  return std::make_unique<Simulation>(scene, &domain, &r);
+}
 
-  Progress progress(opt.quiet, scene.run.duration, out.progress_interval);
-  const auto start = Clock::now();
-  if (!advance(sim, scene, series, snapshots, progress, n_global)) return kExitUnstable;
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  const RunInfo info = run_info(sim, domain, scene, n_global, wall);
-  if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
-  if (!opt.quiet)
-    say(fmt_double("done: %.4g s simulated", sim.time()) +
-        fmt_double(" in %.3g s of wall time", wall) +
-        fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
+std::unique_ptr<SnapshotWriter> open_snapshots(const Scene& scene, const Simulation& sim,
+                                               bool resumed) {
+  const OutputSpec& out = scene.output;
+  if (!resumed)
+    return std::make_unique<SnapshotWriter>(MPI_COMM_WORLD, out.directory, scene.materials);
+  return SnapshotWriter::resume(MPI_COMM_WORLD, out.directory, scene.materials, sim.time(),
+                                0.5 * sim.dt());
+}
+
+// The command that continues an interrupted run.
+std::string resume_command(const Options& opt, const Scene& scene) {
+  std::string cmd = g_size > 1 ? "mpirun -np " + std::to_string(g_size) + " dem2d" : "dem2d";
+  cmd += " --restart " + scene.output.directory + "/" + kCheckpointFile;
+  for (const std::string& set : opt.sets) cmd += " --set " + set;
+  if (!opt.output.empty()) cmd += " --output " + opt.output;
+  if (opt.quiet) cmd += " --quiet";
+  return cmd + " " + opt.deck;
+}
+
+// What the end of a run says, and its exit status.
+int report(const Options& opt, const Scene& scene, const Simulation& sim, const RunLoop& loop,
+           Ending ending) {
+  if (ending == Ending::kInterrupted) {
+    say(scene.deck_path + ": " + (loop.stop_signal() == SIGINT ? "SIGINT" : "SIGTERM") +
+            fmt_double(": the run stopped at t = %.6g s", sim.time()) + " (step " +
+            std::to_string(sim.step_count()) + "); checkpoint, last snapshot and run.json " +
+            "written to " + scene.output.directory + "; resume with:\n  " +
+            resume_command(opt, scene) + "\n",
+        stderr);
+    return kExitInterrupted;
+  }
   if (sim.unconverged_steps() > 0)
     say("warning: the iterative integrator did not converge in " +
             std::to_string(sim.unconverged_steps()) +
@@ -397,12 +516,55 @@ int run(const Options& opt) {
   return kExitUnstable;  // the run went to its end (run.guards = "warn"), but it is not sane
 }
 
+int run(const Options& opt) {
+  Scene scene = load_deck(opt.deck, opt.sets);
+  if (!opt.output.empty()) scene.output.directory = opt.output;
+  if (opt.check) {
+    // Every rank evaluates the whole scene alike; rank 0 prints.
+    const Simulation whole(scene);
+    print_check(whole);
+    return kExitOk;
+  }
+  MpiDomain domain(MPI_COMM_WORLD, decomposition_of(scene));
+  const bool resumed = !opt.restart.empty();
+  const std::unique_ptr<Simulation> owned_sim = make_simulation(opt, scene, domain);
+  Simulation& sim = *owned_sim;
+  const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
+  const OutputSpec& out = scene.output;
+  const OutputLock lock = prepare_output(opt, scene);
+  SeriesOutput series(scene, sim, resumed);
+  const std::unique_ptr<SnapshotWriter> snapshots = open_snapshots(scene, sim, resumed);
+  if (!opt.quiet)
+    say("dem2d " DEM2D_VERSION ": " + scene.deck_path + " (" + std::to_string(n_global) +
+        " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
+        (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory +
+        (resumed ? fmt_double(", continued from t = %.6g s", sim.time()) : "") + "\n");
+
+  Progress progress(opt.quiet, scene.run.duration, out.progress_interval, sim.step_count());
+  const auto start = Clock::now();
+  const std::int64_t first_step = sim.step_count();
+  RunLoop loop(sim, scene, domain, series, *snapshots, resumed);
+  const Ending ending = loop.run(progress, n_global);
+  if (ending == Ending::kUnstable) return kExitUnstable;
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  RunInfo info = run_info(sim, domain, scene, n_global, wall, sim.step_count() - first_step);
+  info.extra.emplace_back("interrupted", ending == Ending::kInterrupted ? "true" : "false");
+  info.extra.emplace_back("restarted_from", resumed ? "\"" + opt.restart + "\"" : "null");
+  if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
+  if (!opt.quiet && ending == Ending::kFinished)
+    say(fmt_double("done: %.4g s simulated", sim.time()) +
+        fmt_double(" in %.3g s of wall time", wall) +
+        fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
+  return report(opt, scene, sim, loop, ending);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   MPI_Init(&argc, &argv);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+  install_stop_handlers();
 
   CLI::App app{"dem2d: 2D discrete element simulator of tumbling ball mills"};
   Options opt;
@@ -412,6 +574,9 @@ int main(int argc, char** argv) {
   app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)")
       ->allow_extra_args(false);
   app.add_option("--output", opt.output, "output directory (overrides output.directory)");
+  app.add_option("--restart", opt.restart,
+                 "continue the run from a checkpoint (DIR/checkpoint.h5) to the deck's "
+                 "run.duration, on any rank count, appending to the output in the deck's folder");
   app.add_flag("--quiet", opt.quiet, "no progress line");
   app.add_flag("--overwrite", opt.overwrite,
                "replace the output of an earlier run in the output directory (never a running "
@@ -424,6 +589,11 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     if (version) {
       say("dem2d " DEM2D_VERSION "\n");
+    } else if (!opt.restart.empty() && opt.overwrite) {
+      say("dem2d: error: --restart continues the output in its folder; --overwrite would remove "
+          "it: give one of them\n",
+          stderr);
+      code = kExitInput;
     } else if (opt.deck.empty()) {
       say("dem2d: error: no input deck given\nRun with --help for more information.\n", stderr);
       code = kExitInput;

@@ -1,5 +1,6 @@
 // The errors dem2d reports to a user, each with its exit status (interface.md):
-// 2 bad input or usage, 3 the run became unstable, 4 an I/O failure.
+// 2 bad input or usage, 3 the run became unstable, 4 an I/O failure, 5 interrupted by SIGINT or
+// SIGTERM after writing a checkpoint to resume from.
 #pragma once
 
 #include <stdexcept>
@@ -8,7 +9,13 @@
 
 namespace dem2d {
 
-enum ExitCode : int { kExitOk = 0, kExitInput = 2, kExitUnstable = 3, kExitIo = 4 };
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitInput = 2,
+  kExitUnstable = 3,
+  kExitIo = 4,
+  kExitInterrupted = 5
+};
 
 // Bad input: one or more complete messages, each already formatted as
 // "FILE:LINE:COL: error: ..." where a line is known.

@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
 #include "core/errors.hpp"
 #include "core/random.hpp"
+#include "core/validate.hpp"
 
 namespace dem2d {
 
@@ -23,8 +25,21 @@ double fill_radius(const Scene& scene, std::size_t f, std::int64_t k) {
   return s.radius_min + u * (s.radius_max - s.radius_min);
 }
 
+// "deck.in:14:9: error: fill[0].count = 5000: ", at the key that sets how many the fill places
+// (Scene::where), else at the fill's line.
 std::string where(const Scene& scene, const FillSpec& s) {
-  return scene.deck_path + ":" + std::to_string(s.source_line) + ": error: [[fill]]: ";
+  const std::string fill = "fill[" + std::to_string(s.index) + "]";
+  const std::string key = fill + (s.count > 0 ? ".count" : ".fill_fraction");
+  const auto it = scene.where.find(key);
+  if (it == scene.where.end())
+    return scene.deck_path + ":" + std::to_string(s.source_line) + ": error: " + fill + ": ";
+  std::ostringstream value;
+  if (s.count > 0) {
+    value << s.count;
+  } else {
+    value << s.fill_fraction;
+  }
+  return it->second + ": error: " + key + " = " + value.str() + ": ";
 }
 
 // Uniform grid of placed particles for overlap checks.
@@ -120,6 +135,7 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
       bool clear = true;
       for (int e = 0; e < static_cast<int>(walls.elements().size()) && clear; ++e)
         if (walls.geometry(e, p, half).delta > 0.0) clear = false;
+      if (clear && lifter_overlap(scene.drum, p, half)) clear = false;  // also inside a bar
       if (!clear || placed.overlaps(p, half, r_all_max)) continue;
       const std::uint64_t id = sites.size();
       const double u = random_uniform(scene.run.seed, kFillStream + 1000 + f, id);
@@ -135,6 +151,7 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
 }  // namespace
 
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store) {
+  check_memory(scene, physical_memory_bytes());  // before anything is allocated
   std::vector<std::string> errors;
   std::int64_t next_id = static_cast<std::int64_t>(store.size());
   for (const ParticleSpec& s : scene.particles) {
@@ -157,10 +174,11 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
     const std::int64_t n = fill_count(scene, f);
     std::vector<Site> sites = fill_sites(scene, walls, store, f, r_all_max);
     if (static_cast<std::int64_t>(sites.size()) < n) {
-      errors.push_back(where(scene, s) + std::to_string(n) +
-                       " particles do not fit: the region holds " + std::to_string(sites.size()) +
-                       " at radius_max " + std::to_string(s.radius_max) +
-                       " m; lower count or fill_fraction, or enlarge the region");
+      std::ostringstream o;
+      o << n << " particles do not fit: the region holds " << sites.size()
+        << " clear of the walls and the particles placed before, at radius_max " << s.radius_max
+        << " m; lower count or fill_fraction, or enlarge the region";
+      errors.push_back(where(scene, s) + o.str());
       continue;
     }
     std::stable_sort(sites.begin(), sites.end(),

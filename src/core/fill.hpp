@@ -11,11 +11,13 @@
 
 #include "core/particles.hpp"
 #include "core/scene.hpp"
+#include "core/validate.hpp"  // check_memory before placing; validate_start once dt is chosen
 #include "core/walls.hpp"
 
 namespace dem2d {
 
-// Throws InputError (naming the fill's deck line) when a region cannot hold its particles.
+// Throws InputError (at the fill's count key, Scene::where) when the particles would not fit in
+// the machine's memory (check_memory, before any is placed) or a region cannot hold them.
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store);
 
 // Number of particles a fill will place (after resolving fill_fraction).

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -112,6 +113,7 @@ struct FillSpec {
   Vec2 box_max{0.0, 0.0};
   Vec2 velocity{0.0, 0.0};  // initial velocity of every filled particle
   int source_line = 0;      // deck line, for error messages
+  int index = 0;            // its element of the deck's [[fill]] array: "fill[2]" in messages
 };
 
 struct ParticleSpec {
@@ -173,7 +175,8 @@ struct OutputSpec {
   std::string directory = "out";
   double series_interval = 1.0e-3;
   double snapshot_interval = 0.0;    // 0: final state only
-  double checkpoint_interval = 0.0;  // 0: none
+  double checkpoint_interval = 0.0;  // s of simulated time; 0: none (but at the end)
+  double checkpoint_minutes = 0.0;   // min of wall-clock time; 0: none
   double progress_interval = 5.0;    // s of wall time between plain progress lines
 };
 
@@ -197,6 +200,11 @@ struct Scene {
   FeedSpec feed;
   SieveSpec sieve;
   OutputSpec output;
+  // Where the deck gave a value that a check after reading may refuse (core/validate.hpp, the
+  // fill placement), by the key's dotted path as messages name it: "run.duration" ->
+  // "deck.in:3:12", or "--set run.duration=9" when an override set it; absent for a default.
+  // "fill[K].csv" holds the CSV file of a fill from a file as messages name it.
+  std::map<std::string, std::string> where;
 };
 
 // A scene with ore models ([breakage], [feed] or [sieve]).

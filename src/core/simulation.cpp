@@ -49,6 +49,7 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
   if (resume) {
     resume_from(*resume);
   } else {
+    domain_->adopt(particles_, halo_width_);
     rebuild();
     refresh_forces();
   }
@@ -102,6 +103,10 @@ void Simulation::load_particles(const Resumption& resume) {
 // half-step velocity, which a new evaluation could not reproduce).
 void Simulation::resume_from(const Resumption& resume) {
   const RunState& s = resume.state;
+  if (resume.histories.width() != contacts_.history_slots().size())
+    throw InputError("the checkpoint's contacts carry " + std::to_string(resume.histories.width()) +
+                     " history values, this scene's contact model " +
+                     std::to_string(contacts_.history_slots().size()));
   time_ = s.time;
   step_ = s.step;
   walls_.update(time_);
@@ -245,6 +250,7 @@ void Simulation::advance_clock() {
 }
 
 void Simulation::rebuild() {
+  if (step_ > 0) check_contained();
   if (domain_->size() > 1) {
     // Particles that left this rank's region move to their owner with their contact
     // histories; then a new ghost set; the lists take their histories from the records.
@@ -259,6 +265,33 @@ void Simulation::rebuild() {
     integrator_->after_rebuild(particles_.n_owned());
   }
   rebuilds_.record(particles_, walls_, time_);
+}
+
+// A particle whose centre is beyond the drum's circle (the polygon's vertices lie on it) has
+// left the drum through its shell and will never come back: the run is unstable (exit 3), with
+// the particle named alike on every rank. Checked at every rebuild (every rank rebuilds at the
+// same step; a particle cannot get far between rebuilds, which the skin bounds).
+void Simulation::check_contained() {
+  if (!walls_.has_drum()) return;
+  const Vec2 c = scene_.drum.center;
+  const double reach2 = scene_.drum.radius * scene_.drum.radius;
+  double escaped = -1.0, distance = 0.0;
+  for (std::size_t k = 0; k < particles_.n_owned(); ++k) {
+    const double d2 = norm2(particles_.pos[k] - c);
+    if (d2 > reach2 && static_cast<double>(particles_.id[k]) > escaped) {
+      escaped = static_cast<double>(particles_.id[k]);
+      distance = std::sqrt(d2);
+    }
+  }
+  const double id = domain_->max(escaped);
+  if (id < 0.0) return;
+  distance = domain_->max(escaped == id ? distance : 0.0);
+  std::ostringstream o;
+  o << "the run became unstable at step " << std::llround(time_ / dt_) << " (t = " << time_
+    << " s): particle " << static_cast<std::int64_t>(id) << " left the drum: its centre is "
+    << distance << " m from the drum's centre, beyond the shell at " << scene_.drum.radius
+    << " m; dt = " << dt_ << " s, the safe dt is " << scales_.safe_dt << " s";
+  throw UnstableError(o.str(), step_, time_);
 }
 
 void Simulation::refresh_ghosts() { domain_->refresh_ghosts(particles_, ghost_fields_); }

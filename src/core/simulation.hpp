@@ -144,6 +144,8 @@ class Simulation final : private StepStages {
 
   void choose_dt();
   void set_up_lists();
+  // A particle outside the drum: UnstableError naming it (collective, at rebuilds).
+  void check_contained();
   // The resuming constructor's part: particles, histories and state from the checkpoint.
   void load_particles(const Resumption& resume);
   void resume_from(const Resumption& resume);

@@ -31,6 +31,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
+#include "core/validate.hpp"
 #include "io/deck_schema.hpp"
 #include "io/particle_csv.hpp"
 #include "io/text.hpp"
@@ -204,6 +205,13 @@ class TableReader {
   // "material[1].density = -5: must be > 0", at the value's position.
   void invalid(std::string_view key, std::string_view what) const {
     const toml::node* node = find(key);
+    if (node == nullptr) {
+      // A rule between keys may name one the deck left out (a [feed] without a [drum] and
+      // without material, or with neither period nor mass_rate): dereferencing the missing
+      // value crashed (found by fuzzing, tests/fuzz/regressions). Said at the table instead.
+      error(fmt::format("{}: {}", path_of(key), what));
+      return;
+    }
     diag_.error_at(*node, fmt::format("{} = {}: {}", path_of(key), diag_.shown(*node), what));
   }
   // The value of `key` as the deck wrote it, for messages about another key.
@@ -446,6 +454,27 @@ bool is_index(std::string_view s) {
          std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
+// True when `s` is well-formed UTF-8 (no overlong forms, surrogates or code points beyond
+// U+10FFFF), as TOML requires of a deck.
+bool valid_utf8(std::string_view s) {
+  static constexpr std::uint32_t kSmallest[] = {0, 0x80, 0x800, 0x10000};  // by extra bytes
+  for (std::size_t i = 0; i < s.size();) {
+    const auto lead = static_cast<unsigned char>(s[i]);
+    const int extra = lead < 0x80 ? 0 : lead >= 0xF0 ? 3 : lead >= 0xE0 ? 2 : lead >= 0xC0 ? 1 : -1;
+    if (extra < 0 || lead > 0xF4 || s.size() - i <= static_cast<std::size_t>(extra)) return false;
+    std::uint32_t code = extra == 0 ? lead : lead & (0x3Fu >> extra);
+    for (int k = 1; k <= extra; ++k) {
+      const auto next = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
+      if ((next & 0xC0) != 0x80) return false;
+      code = (code << 6) | (next & 0x3Fu);
+    }
+    if (code < kSmallest[extra] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF))
+      return false;
+    i += static_cast<std::size_t>(extra) + 1;
+  }
+  return true;
+}
+
 // Sets table[key] to VALUE read as one TOML value ("1.5", "[0, -9.81]", "true", "'steel'"),
 // or, when VALUE is not one, as a bare string ("auto", "steel").
 void assign_override_value(toml::table& table, const std::string& key, std::string_view value) {
@@ -498,6 +527,12 @@ void apply_override(toml::table& root, const std::string& option, Origins& origi
                     Diagnostics& diag) {
   const std::string where = "--set " + option;
   const auto fail = [&](std::string_view message) { diag.error_in(where, message); };
+  // A value taken as a bare string let bytes that are not UTF-8 into the scene, and then its
+  // resolved deck (run.json) did not read back (found with the fuzz target).
+  if (!valid_utf8(option)) {
+    fail("not valid UTF-8 text (a deck and its values are UTF-8)");
+    return;
+  }
   const std::size_t equals = option.find('=');
   if (equals == std::string::npos) {
     fail("expected KEY=VALUE, e.g. drum.speed=1.5");
@@ -600,6 +635,173 @@ void require(const TableReader& r, const deck::Table<T>& spec, std::string_view 
   r.missing(name, expected_text(key->type, key->range));
 }
 
+// ---------------------------------------------------------------------------------------------
+// Placement: where the deck's own particles start (docs/input.md, "Placement")
+
+// How far x lies inside the drum's shell: from the circle, or from the nearest side of the
+// polygon (its vertices on the radius, rotated by drum.angle); negative outside.
+double shell_clearance(const DrumSpec& d, Vec2 x) {
+  const Vec2 rel = x - d.center;
+  double clearance = d.radius - norm(rel);
+  if (d.sides < 3) return clearance;
+  const double apothem = d.radius * std::cos(std::numbers::pi / d.sides);
+  const double step = 2.0 * std::numbers::pi / d.sides;
+  for (int k = 0; k < d.sides; ++k) {
+    const double phi = d.angle + (k + 0.5) * step;  // the outward normal of side k
+    clearance = std::min(clearance, apothem - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
+  }
+  return clearance;
+}
+
+// The particles that one [[fill]] file added to Scene::particles, and the file as messages
+// name it.
+struct FileRows {
+  std::size_t first = 0;
+  std::size_t count = 0;
+  std::size_t fill = 0;  // the element of [[fill]]
+  std::string shown;
+  int reported = 0;  // messages about its rows so far
+};
+
+// Checks the particles the deck places itself, the [[particle]] tables and then the rows of the
+// [[fill]] files (as Scene::particles holds them), before step 1: inside the drum clear of its
+// shell, clear of the lifter bars, and apart from each other. A particle whose disc reaches the
+// shell or a bar, or overlaps another by more than kPlacementOverlap of the smaller radius (a
+// resting Hertz contact overlaps well under 1 %: a packing saved from a settled run passes), is
+// bad input at its table's position, or at its CSV row (at most kMaxCsvErrors rows of a file,
+// then a count of the others).
+class Placement {
+ public:
+  static constexpr double kPlacementOverlap = 0.05;
+
+  Placement(const Scene& scene, Diagnostics& diag, const std::vector<const toml::table*>& tables,
+            std::vector<FileRows> files)
+      : scene_(scene), diag_(diag), tables_(tables), files_(std::move(files)) {}
+
+  void check() {
+    for (std::size_t i = 0; i < scene_.particles.size(); ++i) {
+      if (in_drum(i)) clear_of_lifters(i);
+    }
+    check_pairs();
+    for (const FileRows& file : files_) {
+      if (file.reported > kMaxCsvErrors) {
+        diag_.add(fmt::format("{}: error: {} more misplaced rows in this file not shown",
+                              file.shown, file.reported - kMaxCsvErrors));
+      }
+    }
+  }
+
+ private:
+  // Inside the drum's circle or polygon, by the particle's clearance from the nearest side.
+  bool in_drum(std::size_t i) {
+    const DrumSpec& d = scene_.drum;
+    const ParticleSpec& p = scene_.particles[i];
+    if (!d.present) return false;
+    const double clearance = shell_clearance(d, p.position);
+    if (clearance >= p.radius) return true;
+    report(i,
+           fmt::format("the particle (radius {:g} m) {} the drum (radius {:g} m about [{:g}, "
+                       "{:g}]{}); place it at least its radius inside the shell",
+                       p.radius, clearance <= -p.radius ? "lies outside" : "straddles the shell of",
+                       d.radius, d.center.x, d.center.y,
+                       d.sides >= 3 ? fmt::format(", {} sides", d.sides) : std::string()));
+    return false;
+  }
+
+  void clear_of_lifters(std::size_t i) {
+    const ParticleSpec& p = scene_.particles[i];
+    const auto bar = lifter_overlap(scene_.drum, p.position, p.radius);
+    if (!bar) return;
+    report(i,
+           fmt::format("the particle (radius {:g} m) {} bar {} of drum.lifter[{}] (the bars "
+                       "at the drum's initial angle); place it clear of the lifters",
+                       p.radius, bar->inside ? "lies inside" : "overlaps", bar->bar, bar->lifter));
+  }
+
+  // Pairs closer than allowed, found on a grid of cells as wide as the largest diameter, and
+  // reported at the later particle in deck order.
+  void check_pairs() {
+    const std::vector<ParticleSpec>& ps = scene_.particles;
+    double r_max = 0.0;
+    for (const ParticleSpec& p : ps) r_max = std::max(r_max, p.radius);
+    const double h = 2.0 * r_max;
+    const auto cell = [h](double x) {  // clamped: a far-away particle is reported anyway
+      return static_cast<std::int64_t>(std::clamp(std::floor(x / h), -1.0e9, 1.0e9));
+    };
+    const auto key = [](std::int64_t cx, std::int64_t cy) {
+      return (cx << 32) ^ (cy & 0xffffffff);
+    };
+    std::unordered_map<std::int64_t, std::vector<std::size_t>> cells;
+    for (std::size_t i = 0; i < ps.size(); ++i)
+      cells[key(cell(ps[i].position.x), cell(ps[i].position.y))].push_back(i);
+    std::vector<std::pair<std::size_t, std::size_t>> close;  // (later, earlier)
+    for (std::size_t i = 0; i < ps.size(); ++i) {
+      const std::int64_t cx = cell(ps[i].position.x), cy = cell(ps[i].position.y);
+      for (std::int64_t dx = -1; dx <= 1; ++dx)
+        for (std::int64_t dy = -1; dy <= 1; ++dy) {
+          const auto it = cells.find(key(cx + dx, cy + dy));
+          if (it == cells.end()) continue;
+          for (const std::size_t j : it->second)
+            if (j > i && overlap(i, j) > kPlacementOverlap * smaller(i, j))
+              close.emplace_back(j, i);
+        }
+    }
+    std::sort(close.begin(), close.end());
+    for (const auto& [j, i] : close) report_pair(i, j);
+  }
+
+  double overlap(std::size_t i, std::size_t j) const {
+    const ParticleSpec& p = scene_.particles[i];
+    const ParticleSpec& q = scene_.particles[j];
+    return p.radius + q.radius - norm(q.position - p.position);
+  }
+  double smaller(std::size_t i, std::size_t j) const {
+    return std::min(scene_.particles[i].radius, scene_.particles[j].radius);
+  }
+
+  void report_pair(std::size_t i, std::size_t j) {
+    const double gap = norm(scene_.particles[j].position - scene_.particles[i].position);
+    const double s = smaller(i, j);
+    report(j, gap <= 1e-9 * s
+                  ? fmt::format("coincides with {}; give each particle its own place", name(i))
+                  : fmt::format("overlaps {} by {:.3g} % of the smaller radius; at most {:g} % "
+                                "is allowed at the start",
+                                name(i), 100.0 * overlap(i, j) / s, 100.0 * kPlacementOverlap));
+  }
+
+  // The file whose rows hold particle i (i past the tables).
+  FileRows& file_of(std::size_t i) {
+    auto it = std::upper_bound(files_.begin(), files_.end(), i,
+                               [](std::size_t k, const FileRows& f) { return k < f.first; });
+    return *(it - 1);
+  }
+
+  // "particle[3] (line 12)", or a row "packing.csv:4".
+  std::string name(std::size_t i) {
+    if (i < tables_.size())
+      return fmt::format("particle[{}] (line {})", i, scene_.particles[i].source_line);
+    return fmt::format("{}:{}", file_of(i).shown, scene_.particles[i].source_line);
+  }
+
+  // At a table's position, or at the CSV row ("fill[2].file row: position = [x, y]: ...").
+  void report(std::size_t i, std::string_view what) {
+    if (i < tables_.size()) {
+      TableReader(diag_, *tables_[i], deck::kParticle, i).invalid("position", what);
+      return;
+    }
+    FileRows& file = file_of(i);
+    if (++file.reported > kMaxCsvErrors) return;
+    const ParticleSpec& p = scene_.particles[i];
+    diag_.add(fmt::format("{}:{}: error: fill[{}].file row: position = [{:g}, {:g}]: {}",
+                          file.shown, p.source_line, file.fill, p.position.x, p.position.y, what));
+  }
+
+  const Scene& scene_;
+  Diagnostics& diag_;
+  const std::vector<const toml::table*>& tables_;
+  std::vector<FileRows> files_;
+};
+
 class DeckParser {
  public:
   DeckParser(const toml::table& root, Diagnostics& diag, fs::path deck_dir)
@@ -619,9 +821,9 @@ class DeckParser {
     // [[particle]] before [[fill]]: file fills append their particles after the explicit ones.
     const auto particles = root.table_array("particle");
     for (std::size_t i = 0; i < particles.size(); ++i) read_particle(*particles[i], i);
-    if (diag_.messages().empty()) check_placement(particles);
     const auto fills = root.table_array("fill");
     for (std::size_t i = 0; i < fills.size(); ++i) read_fill(*fills[i], i);
+    if (diag_.messages().empty()) Placement(scene_, diag_, particles, file_rows_).check();
     const auto walls = root.table_array("wall");
     for (std::size_t i = 0; i < walls.size(); ++i) read_wall(*walls[i], i);
     if (const auto* t = root.table("breakage")) read_breakage(*t);
@@ -742,7 +944,7 @@ class DeckParser {
       } else {
         r.invalid("shear_modulus",
                   fmt::format("gives poisson_ratio = youngs_modulus / (2 shear_modulus) - 1 "
-                              "= {}, which must be in [-1, 0.5) (shear_modulus > {})",
+                              "= {:.6g}, which must be in [-1, 0.5) (shear_modulus > {:.6g})",
                               nu, *youngs / 3.0));
       }
     } else if (youngs) {
@@ -822,6 +1024,11 @@ class DeckParser {
     scene_.interactions.push_back(std::move(spec));
   }
 
+  // The most sides of a polygonal drum and lifter bars in all: the thesis's drum has 16 sides
+  // and 12 bars; a circle is sides = 0.
+  static constexpr int kMaxDrumSides = 10000;
+  static constexpr int kMaxLifterBars = 10000;
+
   void read_drum(const toml::table& table) {
     const TableReader r(diag_, table, deck::kDrum);
     DrumSpec& drum = scene_.drum;
@@ -832,6 +1039,11 @@ class DeckParser {
     if (const auto sides = accepted.get<std::int64_t>("sides");
         sides && (*sides == 1 || *sides == 2)) {
       r.invalid("sides", "must be 0 (a circle) or >= 3 (a regular polygon)");
+    } else if (sides && *sides > kMaxDrumSides) {
+      // The placement and feed checks walk the sides for every particle and the walls make one
+      // element of each: sides = 2147483647 hung the reader (found with the fuzz target).
+      r.invalid("sides", fmt::format("must be at most {} (a circle is sides = 0)", kMaxDrumSides));
+      drum.sides = 0;  // the checks that follow see a circle
     }
     const auto lifters = r.table_array("lifter");
     for (std::size_t i = 0; i < lifters.size(); ++i) read_lifter(*lifters[i], i, radius);
@@ -846,9 +1058,9 @@ class DeckParser {
       if (r.has(key)) speeds.push_back(key);
     }
     if (speeds.size() > 1) {
-      r.error_at(speeds[1], fmt::format("drum: give only one of speed, speed_rpm and "
-                                        "critical_fraction (found {})",
-                                        and_list(speeds)));
+      r.invalid(speeds[1], fmt::format("give only one of speed, speed_rpm and critical_fraction "
+                                       "(found {})",
+                                       and_list(speeds)));
       return;
     }
     const auto fraction = accepted.get<double>("critical_fraction");
@@ -869,80 +1081,16 @@ class DeckParser {
     if (height && radius && *height >= *radius) {
       r.invalid("height", fmt::format("must be < drum.radius = {}", *radius));
     }
-    scene_.drum.lifters.push_back(std::move(lifter));
-  }
-
-  // Where the deck's [[particle]] tables put their particles (before step 1; docs/input.md,
-  // "Placement"): inside the drum clear of its shell, and apart from each other. A particle
-  // whose disc reaches the shell, or overlaps another by more than kPlacementOverlap of the
-  // smaller radius (a resting Hertz contact overlaps well under 1 %), is bad input.
-  static constexpr double kPlacementOverlap = 0.05;
-  void check_placement(const std::vector<const toml::table*>& tables) {
-    const std::size_t n = tables.size();  // one particle per table, every key valid
-    const std::vector<Vec2> sides = side_normals();
-    for (std::size_t i = 0; i < n; ++i) check_in_drum(*tables[i], i, sides);
-    std::vector<std::size_t> order(n);
-    for (std::size_t i = 0; i < n; ++i) order[i] = i;
-    const auto x = [&](std::size_t i) { return scene_.particles[i].position.x; };
-    std::sort(order.begin(), order.end(), [&](auto a, auto b) { return x(a) < x(b); });
-    double r_max = 0.0;
-    for (std::size_t i = 0; i < n; ++i) r_max = std::max(r_max, scene_.particles[i].radius);
-    for (std::size_t a = 0; a < n; ++a)  // a sweep along x: pairs closer than 2 r_max in x
-      for (std::size_t b = a + 1; b < n && x(order[b]) - x(order[a]) < 2.0 * r_max; ++b)
-        check_apart(tables, std::min(order[a], order[b]), std::max(order[a], order[b]));
-  }
-
-  // The outward normals of the drum polygon's sides (its vertices on the radius, rotated by
-  // drum.angle); none for a circle or no drum.
-  std::vector<Vec2> side_normals() const {
-    const DrumSpec& d = scene_.drum;
-    std::vector<Vec2> normals;
-    if (!d.present || d.sides < 3) return normals;
-    const double step = 2.0 * std::numbers::pi / d.sides;
-    for (int k = 0; k < d.sides; ++k) {
-      const double phi = d.angle + (k + 0.5) * step;
-      normals.push_back({std::cos(phi), std::sin(phi)});
+    // Each bar is three wall elements and the checks walk every bar: count = 2147483647 hung
+    // the reader and asked the walls for 2^31 x 3 elements (found with the fuzz target).
+    int bars = 0;  // of the lifters before this one, at most kMaxLifterBars
+    for (const LifterSpec& l : scene_.drum.lifters) bars += l.count;
+    if (lifter.count > kMaxLifterBars - bars) {
+      r.invalid("count", fmt::format("makes {} lifter bars in all; at most {} are allowed",
+                                     std::int64_t{bars} + lifter.count, kMaxLifterBars));
+      lifter.count = 0;  // the checks that follow see no bars
     }
-    return normals;
-  }
-
-  // Inside the drum's circle or polygon, by the particle's clearance from the nearest side.
-  void check_in_drum(const toml::table& table, std::size_t i, const std::vector<Vec2>& sides) {
-    const DrumSpec& d = scene_.drum;
-    const ParticleSpec& p = scene_.particles[i];
-    if (!d.present) return;
-    const Vec2 rel = p.position - d.center;
-    double clearance = d.radius - norm(rel);
-    const double apothem = sides.empty() ? 0.0 : d.radius * std::cos(std::numbers::pi / d.sides);
-    for (const Vec2& normal : sides) clearance = std::min(clearance, apothem - dot(rel, normal));
-    if (clearance >= p.radius) return;
-    const TableReader r(diag_, table, deck::kParticle, i);
-    r.invalid(
-        "position",
-        fmt::format("the particle (radius {:g} m) {} the drum (radius {:g} m about [{:g}, "
-                    "{:g}]{}); place it at least its radius inside the shell",
-                    p.radius, clearance <= -p.radius ? "lies outside" : "straddles the shell of",
-                    d.radius, d.center.x, d.center.y,
-                    d.sides >= 3 ? fmt::format(", {} sides", d.sides) : std::string()));
-  }
-
-  void check_apart(const std::vector<const toml::table*>& tables, std::size_t i, std::size_t j) {
-    const ParticleSpec& p = scene_.particles[i];
-    const ParticleSpec& q = scene_.particles[j];
-    const double gap = norm(q.position - p.position);
-    const double overlap = p.radius + q.radius - gap;
-    const double smaller = std::min(p.radius, q.radius);
-    if (overlap <= kPlacementOverlap * smaller) return;
-    const TableReader r(diag_, *tables[j], deck::kParticle, j);
-    r.invalid(
-        "position",
-        gap <= 1e-9 * smaller
-            ? fmt::format("coincides with particle[{}] (line {}); give each particle its "
-                          "own place",
-                          i, p.source_line)
-            : fmt::format("overlaps particle[{}] (line {}) by {:.3g} % of the smaller "
-                          "radius; at most {:g} % is allowed at the start",
-                          i, p.source_line, 100.0 * overlap / smaller, 100.0 * kPlacementOverlap));
+    scene_.drum.lifters.push_back(std::move(lifter));
   }
 
   void read_particle(const toml::table& table, std::size_t index) {
@@ -957,6 +1105,7 @@ class DeckParser {
     const TableReader r(diag_, table, deck::kFill, index);
     FillSpec fill;
     fill.source_line = r.line();
+    fill.index = static_cast<int>(index);
     const Accepted accepted = read_keys(r, deck::kFill, fill);
     std::vector<std::string_view> sources;
     for (const std::string_view key : {"count", "fill_fraction", "file"}) {
@@ -1052,14 +1201,21 @@ class DeckParser {
       r.invalid("file", fmt::format("cannot read {}: {}", shown, std::strerror(read_errno)));
       return;
     }
-    const CsvPacking packing = read_particle_csv(text, shown, defined_materials(),
-                                                 CsvDefaults{fill.material, fill.velocity});
+    const CsvPacking packing =
+        read_particle_csv(text, shown, defined_materials(),
+                          CsvDefaults{fill.material, fill.velocity}, r.path_of("file"));
+    for (const std::string& message : packing.file_errors) r.invalid("file", shown + " " + message);
     for (const std::string& message : packing.errors) diag_.add(message);
     if (!packing.has_material_column && fill.material.empty() && !r.has("material")) {
       r.error(fmt::format("{}.material is required: {} has no material column", r.path(), shown));
     }
-    if (!packing.errors.empty() || packing.particles.empty()) return;
+    if (!packing.errors.empty() || !packing.file_errors.empty() || packing.particles.empty()) {
+      return;
+    }
     fill.count = static_cast<std::int64_t>(packing.particles.size());
+    file_rows_.push_back({scene_.particles.size(), packing.particles.size(),
+                          static_cast<std::size_t>(fill.index), shown});
+    scene_.where[fmt::format("{}.csv", r.path())] = shown;
     scene_.particles.insert(scene_.particles.end(), packing.particles.begin(),
                             packing.particles.end());
     scene_.file_fills.push_back(std::move(fill));
@@ -1104,6 +1260,29 @@ class DeckParser {
       r.invalid("point", "a feed needs a [drum]");
     } else if (!scene_.drum.present) {
       r.invalid("material", "a feed needs a [drum] to place its particles in");
+    } else if (accepted.has("point") && accepted.has("radius_max") && scene_.drum.radius > 0.0) {
+      check_feed_point(r, f);
+    }
+  }
+
+  // A fed particle of the largest radius fits at the point: inside the shell, clear of the
+  // lifter bars (else it would fall forever outside the drum, or start inside a bar).
+  void check_feed_point(const TableReader& r, const FeedSpec& f) {
+    const DrumSpec& d = scene_.drum;
+    const double clearance = shell_clearance(d, f.point);
+    if (clearance < f.radius_max) {
+      r.invalid("point",
+                fmt::format("a fed particle of radius_max {:g} m {} the drum (radius {:g} "
+                            "m about [{:g}, {:g}]); give a point at least radius_max "
+                            "inside the shell",
+                            f.radius_max,
+                            clearance <= -f.radius_max ? "lies outside" : "straddles the shell of",
+                            d.radius, d.center.x, d.center.y));
+    } else if (const auto bar = lifter_overlap(d, f.point, f.radius_max)) {
+      r.invalid("point", fmt::format("a fed particle of radius_max {:g} m {} bar {} of "
+                                     "drum.lifter[{}]; give a point clear of the lifters",
+                                     f.radius_max, bar->inside ? "lies inside" : "overlaps",
+                                     bar->bar, bar->lifter));
     }
   }
 
@@ -1126,9 +1305,6 @@ class DeckParser {
     if (accepted.has("directory") && output.directory.empty()) {
       r.invalid("directory", "must not be empty");
     }
-    if (accepted.has("checkpoint_interval") && output.checkpoint_interval > 0.0) {
-      r.invalid("checkpoint_interval", "checkpoints are not implemented yet; use 0");
-    }
   }
 
   const toml::table& root_;
@@ -1139,7 +1315,56 @@ class DeckParser {
   std::optional<ContactModelKind> model_ = ContactModelKind::kHertzMindlin;
   std::vector<std::string> material_names_;  // by index; "" where the name was invalid
   std::map<std::pair<std::string, std::string>, std::size_t> interaction_pairs_;
+  std::vector<FileRows> file_rows_;  // the particles each [[fill]] file added, in order
 };
+
+// Where the deck gave the values that the checks after reading may refuse (Scene::where):
+// the count and velocities of what the core places, the duration, the drum's speed.
+void record_where(const toml::table& root, const Diagnostics& diag, Scene& scene) {
+  const auto put = [&](const std::string& key, const toml::node* node) {
+    if (node != nullptr) scene.where[key] = diag.where(*node);
+  };
+  for (const char* key : {"run.duration", "run.dt", "drum.speed", "drum.speed_rpm",
+                          "drum.critical_fraction", "feed.velocity", "output.directory"}) {
+    put(key, root.at_path(key).node());
+  }
+  const auto each = [&](std::string_view name, std::initializer_list<std::string_view> keys) {
+    const toml::array* tables = root.get_as<toml::array>(name);
+    for (std::size_t i = 0; tables != nullptr && i < tables->size(); ++i) {
+      const toml::table* table = tables->get(i)->as_table();
+      if (table == nullptr) continue;
+      for (const std::string_view key : keys) {
+        put(fmt::format("{}[{}].{}", name, i, key), table->get(key));
+      }
+    }
+  };
+  each("particle", {"velocity", "spin"});
+  each("fill", {"count", "fill_fraction", "radius", "radius_max", "velocity", "file"});
+  each("wall", {"velocity"});
+}
+
+// For a syntax error at `line` (1-based): the line as the deck wrote it and the table header
+// above it, so that the message shows the key: " (in [run]: duration = 1.0.0)".
+std::string syntax_context(std::string_view text, std::size_t line) {
+  std::string_view table, here;
+  std::size_t n = 1;
+  for (std::size_t start = 0; start <= text.size() && n <= line; ++n) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::string_view row = trim(text.substr(start, end - start));
+    if (n == line) {
+      here = row;
+    } else if (row.starts_with('[')) {
+      table = trim(row.substr(0, row.find('#')));
+    }
+    start = end + 1;
+  }
+  if (here.empty()) return "";
+  constexpr std::size_t kShown = 60;
+  const std::string shown =
+      std::string(here.substr(0, kShown)) + (here.size() > kShown ? "..." : "");
+  if (table.empty() || here.starts_with('[')) return fmt::format(" (the line: {})", shown);
+  return fmt::format(" (in {}: {})", table, shown);
+}
 
 }  // namespace
 
@@ -1150,8 +1375,8 @@ Scene parse_deck_string(const std::string& text, const std::string& path_for_mes
     root = toml::parse(text, std::string_view(path_for_messages));
   } catch (const toml::parse_error& e) {
     const auto& at = e.source().begin;
-    throw InputError(
-        fmt::format("{}:{}:{}: error: {}", path_for_messages, at.line, at.column, e.description()));
+    throw InputError(fmt::format("{}:{}:{}: error: {}{}", path_for_messages, at.line, at.column,
+                                 e.description(), syntax_context(text, at.line)));
   }
   Origins origins;
   Diagnostics diag(path_for_messages, origins);
@@ -1164,6 +1389,7 @@ Scene parse_deck_string(const std::string& text, const std::string& path_for_mes
   if (!diag.messages().empty()) throw InputError(std::move(diag.messages()));
   scene.deck_path = path_for_messages;
   if (const toml::node* dt = root.at_path("run.dt").node()) scene.run.dt_where = diag.where(*dt);
+  record_where(root, diag, scene);
   return scene;
 }
 

@@ -886,8 +886,14 @@ inline constexpr Key<OutputSpec> kOutputKeys[] = {
      .unit = "s",
      .range = kNonNegative,
      .field = member<&OutputSpec::checkpoint_interval>(),
-     .allowed = "0",
-     .doc = "checkpoints are not implemented yet: 0 (none) is the only value accepted"},
+     .doc = "simulated time between checkpoints (`checkpoint.h5`, replaced each time); 0: none "
+            "on the way. A checkpoint is always written at the end and when the run is "
+            "interrupted"},
+    {.name = "checkpoint_minutes",
+     .unit = "min",
+     .range = kNonNegative,
+     .field = member<&OutputSpec::checkpoint_minutes>(),
+     .doc = "wall-clock minutes between checkpoints (rank 0's clock); 0: none"},
     {.name = "progress_interval",
      .unit = "s",
      .range = kPositive,

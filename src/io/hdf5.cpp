@@ -49,19 +49,39 @@ RowRange rank0_rows(MPI_Comm comm, std::size_t count) {
   return {0, mpi::rank(comm) == 0 ? n : 0, n};
 }
 
+namespace {
+
+// The file access properties of a ParallelFile: the MPI-IO driver on `comm`, metadata written
+// collectively (fewer, larger writes at many ranks). An invalid handle on failure.
+PropListHandle mpio_access(MPI_Comm comm) {
+  PropListHandle fapl(H5Pcreate(H5P_FILE_ACCESS));
+  if (!fapl.valid()) return fapl;
+  if (H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL) < 0 ||
+      H5Pset_coll_metadata_write(fapl.get(), true) < 0)
+    return PropListHandle();
+  return fapl;
+}
+
+}  // namespace
+
 ParallelFile ParallelFile::create(MPI_Comm comm, const std::string& path) {
   silence_hdf5_error_printing();
   ParallelFile f(comm, path);
-  auto create_failed = [&] {
+  const PropListHandle fapl = mpio_access(comm);
+  if (fapl.valid())
+    f.file_ = FileHandle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
+  if (!f.file_.valid())
     throw IoError(fmt::format("cannot create {}: {}", path, error_stack_detail()));
-  };
-  PropListHandle fapl(H5Pcreate(H5P_FILE_ACCESS));
-  if (!fapl.valid()) create_failed();
-  if (H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL) < 0) create_failed();
-  // Metadata is written collectively: fewer, larger writes at many ranks.
-  if (H5Pset_coll_metadata_write(fapl.get(), true) < 0) create_failed();
-  f.file_ = FileHandle(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()));
-  if (!f.file_.valid()) create_failed();
+  return f;
+}
+
+ParallelFile ParallelFile::open(MPI_Comm comm, const std::string& path) {
+  silence_hdf5_error_printing();
+  ParallelFile f(comm, path);
+  const PropListHandle fapl = mpio_access(comm);
+  if (fapl.valid()) f.file_ = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDWR, fapl.get()));
+  if (!f.file_.valid())
+    throw IoError(fmt::format("cannot open {}: {}", path, error_stack_detail()));
   return f;
 }
 
@@ -70,13 +90,104 @@ void ParallelFile::fail(const std::string& operation, const std::string& object)
       fmt::format("{}: cannot {} '{}': {}", path_, operation, object, error_stack_detail()));
 }
 
-void ParallelFile::create_group(const std::string& name) {
+void ParallelFile::create_group(const std::string& name, bool track_order) {
   PropListHandle lcpl(check(H5Pcreate(H5P_LINK_CREATE), "create link properties for", name));
   check(H5Pset_create_intermediate_group(lcpl.get(), 1), "set link properties for", name);
+  PropListHandle gcpl(check(H5Pcreate(H5P_GROUP_CREATE), "create group properties for", name));
+  if (track_order)
+    check(H5Pset_link_creation_order(gcpl.get(), H5P_CRT_ORDER_TRACKED | H5P_CRT_ORDER_INDEXED),
+          "set group properties for", name);
   GroupHandle group(
-      check(H5Gcreate2(file_.get(), name.c_str(), lcpl.get(), H5P_DEFAULT, H5P_DEFAULT),
+      check(H5Gcreate2(file_.get(), name.c_str(), lcpl.get(), gcpl.get(), H5P_DEFAULT),
             "create group", name));
   check(group.close(), "close group", name);
+}
+
+void ParallelFile::move_link(const std::string& from, const std::string& to) {
+  check(H5Lmove(file_.get(), from.c_str(), file_.get(), to.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+        "move link", from + "' to '" + to);
+}
+
+void ParallelFile::remove_link(const std::string& name) {
+  check(H5Ldelete(file_.get(), name.c_str(), H5P_DEFAULT), "remove link", name);
+}
+
+bool ParallelFile::link_exists(const std::string& name) const {
+  return check(H5Lexists(file_.get(), name.c_str(), H5P_DEFAULT), "look up", name) > 0;
+}
+
+std::vector<std::string> ParallelFile::group_members(const std::string& group) const {
+  GroupHandle g(check(H5Gopen2(file_.get(), group.c_str(), H5P_DEFAULT), "open group", group));
+  PropListHandle gcpl(check(H5Gget_create_plist(g.get()), "read properties of", group));
+  unsigned order = 0;
+  check(H5Pget_link_creation_order(gcpl.get(), &order), "read properties of", group);
+  const H5_index_t index =
+      (order & H5P_CRT_ORDER_TRACKED) != 0 ? H5_INDEX_CRT_ORDER : H5_INDEX_NAME;
+  std::vector<std::string> names;
+  auto collect = [](hid_t, const char* name, const H5L_info_t*, void* out) -> herr_t {
+    static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+    return 0;
+  };
+  check(H5Literate(g.get(), index, H5_ITER_INC, nullptr, collect, &names), "list group", group);
+  return names;
+}
+
+double ParallelFile::read_double_attribute(const std::string& object,
+                                           const std::string& attribute) const {
+  double value = 0.0;
+  read_scalar_attribute(object, attribute, H5T_NATIVE_DOUBLE, &value);
+  return value;
+}
+
+std::int64_t ParallelFile::read_int64_attribute(const std::string& object,
+                                                const std::string& attribute) const {
+  std::int64_t value = 0;
+  read_scalar_attribute(object, attribute, H5T_NATIVE_INT64, &value);
+  return value;
+}
+
+std::string ParallelFile::read_string_attribute(const std::string& object,
+                                                const std::string& attribute) const {
+  const std::string what = object + "@" + attribute;
+  AttributeHandle attr(check(
+      H5Aopen_by_name(file_.get(), object.c_str(), attribute.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+      "open attribute", what));
+  DatatypeHandle type(check(H5Aget_type(attr.get()), "read the type of", what));
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
+    throw IoError(fmt::format("{}: cannot read '{}': not a fixed-length string", path_, what));
+  const std::size_t width = H5Tget_size(type.get());
+  std::vector<char> buffer(width + 1, '\0');
+  check(H5Aread(attr.get(), type.get(), buffer.data()), "read attribute", what);
+  return std::string(buffer.data());
+}
+
+void ParallelFile::read_scalar_attribute(const std::string& object, const std::string& attribute,
+                                         hid_t memory_type, void* value) const {
+  const std::string what = object + "@" + attribute;
+  AttributeHandle attr(check(
+      H5Aopen_by_name(file_.get(), object.c_str(), attribute.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+      "open attribute", what));
+  check(H5Aread(attr.get(), memory_type, value), "read attribute", what);
+}
+
+ParallelFile::DatasetShape ParallelFile::dataset_shape(const std::string& name) const {
+  DatasetHandle d(check(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), "open dataset", name));
+  DatatypeHandle type(check(H5Dget_type(d.get()), "read the type of", name));
+  DataspaceHandle space(check(H5Dget_space(d.get()), "read the shape of", name));
+  const int rank = check(H5Sget_simple_extent_ndims(space.get()), "read the shape of", name);
+  std::array<hsize_t, 2> dims{0, 1};
+  if (rank < 1 || rank > 2)
+    throw IoError(fmt::format("{}: cannot read '{}': {} dimensions", path_, name, rank));
+  check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), "read the shape of", name);
+  const H5T_class_t cls = H5Tget_class(type.get());
+  const std::size_t size = H5Tget_size(type.get());
+  DatasetShape shape{"", dims[0], rank == 2 ? static_cast<std::size_t>(dims[1]) : 1};
+  if (cls == H5T_FLOAT && size == 8) shape.type = "double";
+  if (cls == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_2 && (size == 8 || size == 4))
+    shape.type = size == 8 ? "int64" : "int32";
+  if (shape.type.empty())
+    throw IoError(fmt::format("{}: cannot read '{}': not int64, int32 or double", path_, name));
+  return shape;
 }
 
 void ParallelFile::write_attribute(const std::string& object, const std::string& attribute,

@@ -90,8 +90,21 @@ class ParallelFile {
   const std::string& path() const { return path_; }
   MPI_Comm comm() const { return comm_; }
 
-  // Creates the group at the absolute path `name`, with any missing parents.
-  void create_group(const std::string& name);
+  // Collective: opens the existing `path` for reading and writing with the MPI-IO driver.
+  // Throws IoError "cannot open PATH: REASON" on failure (on the failing ranks, as create).
+  static ParallelFile open(MPI_Comm comm, const std::string& path);
+
+  // Creates the group at the absolute path `name`, with any missing parents. With
+  // `track_order`, the group records the creation order of its members (members() lists
+  // them in that order).
+  void create_group(const std::string& name, bool track_order = false);
+
+  // Collective: renames the link `from` to `to` (absolute paths; H5Lmove, the object is not
+  // copied). The parent group of `to` must exist.
+  void move_link(const std::string& from, const std::string& to);
+  // Collective: removes the link `name` (H5Ldelete). The object's space in the file is not
+  // reclaimed.
+  void remove_link(const std::string& name);
 
   // Scalar attribute `attribute` on the object at `object` (an absolute path).
   void write_attribute(const std::string& object, const std::string& attribute, double value);
@@ -114,6 +127,28 @@ class ParallelFile {
   // ranks (rank 0's are written).
   void write_strings(const std::string& name, const std::vector<std::string>& values);
 
+  // Reading. Not collective (every rank may read alone), but every rank that reads sees the
+  // same file. A missing object or a failed read throws IoError "PATH: cannot ... 'OBJECT':
+  // REASON".
+  // Whether the link `name` (an absolute path whose parent groups exist) exists.
+  bool link_exists(const std::string& name) const;
+  // The names of the members of the group `group`: in creation order when the group tracks
+  // it (create_group's `track_order`), else in name order.
+  std::vector<std::string> group_members(const std::string& group) const;
+  double read_double_attribute(const std::string& object, const std::string& attribute) const;
+  std::int64_t read_int64_attribute(const std::string& object, const std::string& attribute) const;
+  // A fixed-length string attribute (what write_attribute writes for a std::string).
+  std::string read_string_attribute(const std::string& object, const std::string& attribute) const;
+  // The element type and shape of the dataset `name`: type "int64", "int32" or "double"
+  // (IoError for any other), `rows` its first dimension, `columns` its second (1 for a 1-D
+  // dataset; IoError for more than 2 dimensions).
+  struct DatasetShape {
+    std::string type;
+    std::uint64_t rows = 0;
+    std::size_t columns = 1;
+  };
+  DatasetShape dataset_shape(const std::string& name) const;
+
   // Collective: pushes everything written so far to the file (H5Fflush, global scope).
   void flush();
   // Collective: closes the file, checking the result. Later calls do nothing.
@@ -123,6 +158,8 @@ class ParallelFile {
   ParallelFile(MPI_Comm comm, std::string path) : comm_(comm), path_(std::move(path)) {}
   void write_scalar_attribute(const std::string& object, const std::string& attribute,
                               hid_t file_type, hid_t memory_type, const void* value);
+  void read_scalar_attribute(const std::string& object, const std::string& attribute,
+                             hid_t memory_type, void* value) const;
   void write_rows_typed(const std::string& name, const RowRange& range, hid_t file_type,
                         hid_t memory_type, const void* data, std::size_t columns);
   [[noreturn]] void fail(const std::string& operation, const std::string& object) const;

@@ -9,20 +9,25 @@
 
 #include "core/errors.hpp"
 #include "io/output_dir.hpp"
+#include "io/series.hpp"
 
 namespace dem2d {
 
-OreLogs::OreLogs(const std::string& directory, bool active)
+OreLogs::OreLogs(const std::string& directory, bool active, double continue_after_time)
     : product_path_(directory + "/" + kProductFile),
       breakages_path_(directory + "/" + kBreakagesFile) {
   if (!active) return;
   for (auto [file, path, header] :
-       {std::tuple{&product_, &product_path_, "time,id,radius,mass\n"},
+       {std::tuple{&product_, &product_path_, "time,id,radius,mass"},
         std::tuple{&breakages_, &breakages_path_,
-                   "time,parent_id,radius,energy,fragments,first_fragment_id\n"}}) {
+                   "time,parent_id,radius,energy,fragments,first_fragment_id"}}) {
+    if (continue_after_time >= 0.0) {
+      file->reset(continue_csv(*path, header, 0, continue_after_time));
+      continue;
+    }
     file->reset(std::fopen(path->c_str(), "w"));
     if (!*file) throw IoError(fmt::format("cannot create {}: {}", *path, std::strerror(errno)));
-    put(file->get(), *path, header);
+    put(file->get(), *path, std::string(header) + "\n");
   }
 }
 

@@ -15,8 +15,10 @@ namespace dem2d {
 
 class OreLogs {
  public:
-  // Creates (truncating) both files with their headers. Throws IoError when it cannot.
-  OreLogs(const std::string& directory, bool active);
+  // Creates (truncating) both files with their headers; or, with `continue_after_time` >= 0 (a
+  // restart), keeps their rows up to that time and appends after them. Throws IoError when it
+  // cannot.
+  OreLogs(const std::string& directory, bool active, double continue_after_time = -1.0);
   // Appends the records (of every rank, gathered by the caller), sorted by (time, id).
   void write(std::vector<BreakageRecord> breakages, std::vector<ProductRecord> product);
 

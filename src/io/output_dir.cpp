@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <signal.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -54,12 +55,23 @@ struct LockHolder {
   bool running_here = false;  // on this host and the process is alive
 };
 
+// A process that has ended but not been reaped yet (state Z in /proc/PID/stat) still answers
+// kill(pid, 0): it is not running.
+bool is_zombie(long pid) {
+  std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const std::size_t close = line.rfind(')');  // the name in parentheses may hold spaces
+  return close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'Z';
+}
+
 LockHolder read_lock(const fs::path& lock, const std::string& host) {
   LockHolder h;
   std::ifstream in(lock);
   in >> h.host >> h.pid;
   if (h.host == host && h.pid > 0)
-    h.running_here = ::kill(static_cast<pid_t>(h.pid), 0) == 0 || errno == EPERM;
+    h.running_here =
+        (::kill(static_cast<pid_t>(h.pid), 0) == 0 || errno == EPERM) && !is_zombie(h.pid);
   return h;
 }
 
@@ -84,7 +96,7 @@ std::string take_lock(const fs::path& lock, const std::string& shown, const std:
 }
 
 // The claim's verdict on rank 0: empty when the folder is this run's now (its lock taken).
-std::string claim(const fs::path& dir, const std::string& shown, bool overwrite) {
+std::string claim(const fs::path& dir, const std::string& shown, Claim how) {
   if (const std::string reason = check_directory(dir); !reason.empty())
     return fmt::format(
         "cannot write to output directory '{}': {}; give a directory you can "
@@ -110,19 +122,36 @@ std::string claim(const fs::path& dir, const std::string& shown, bool overwrite)
   }
   for (const char* name : kRunOutputs)
     if (fs::exists(dir / name, ec)) found.emplace_back(name);
-  if (!found.empty() && !overwrite)
+  if (!found.empty() && how == Claim::kNew)
     return fmt::format(
         "output directory '{}' holds another run's output ({}); give this run a "
         "new folder with --output DIR, or --overwrite to replace that output",
         shown, fmt::join(found, ", "));
-  if (overwrite) {
-    fs::remove(lock, ec);
+  fs::remove(lock, ec);
+  if (how == Claim::kOverwrite)
     for (const char* name : kRunOutputs) fs::remove(dir / name, ec);
-  }
   return take_lock(lock, shown, host);
 }
 
 }  // namespace
+
+void ensure_free_space(MPI_Comm comm, const std::string& path, std::uint64_t bytes) {
+  std::string error;
+  if (mpi::rank(comm) == 0) {
+    const fs::path file(path);
+    const fs::path dir = file.has_parent_path() ? file.parent_path() : fs::path(".");
+    struct statvfs st {};
+    if (::statvfs(dir.c_str(), &st) == 0) {
+      const auto free = static_cast<std::uint64_t>(st.f_bavail) * st.f_frsize;
+      if (free < 2 * bytes)
+        error = fmt::format(
+            "cannot write {}: No space left on device ({} kB free, the write needs about {} kB "
+            "and dem2d keeps as much again in reserve)",
+            path, free / 1024, (bytes + 1023) / 1024);
+    }
+  }
+  mpi::agree_on_failure<IoError>(comm, error);
+}
 
 OutputLock::~OutputLock() {
   if (path_.empty()) return;
@@ -130,11 +159,11 @@ OutputLock::~OutputLock() {
   fs::remove(path_, ec);
 }
 
-OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, bool overwrite) {
+OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, Claim how) {
   std::string error, lock_path;
   const fs::path path = dir.empty() ? fs::path(".") : fs::path(dir);
   if (mpi::rank(comm) == 0) {
-    error = claim(path, dir, overwrite);
+    error = claim(path, dir, how);
     if (error.empty()) lock_path = (path / kOutputLockName).string();
   }
   OutputLock lock(lock_path);  // removed again if any rank fails below

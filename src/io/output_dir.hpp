@@ -32,8 +32,10 @@ inline constexpr const char* kSnapshotsFile = "snapshots.h5";
 inline constexpr const char* kXdmfFile = "snapshots.xmf";
 inline constexpr const char* kProductFile = "product.csv";
 inline constexpr const char* kBreakagesFile = "breakages.csv";
-inline constexpr const char* kRunOutputs[] = {kRunJsonFile, kSeriesFile,  kSnapshotsFile,
-                                              kXdmfFile,    kProductFile, kBreakagesFile};
+inline constexpr const char* kCheckpointFile = "checkpoint.h5";
+inline constexpr const char* kRunOutputs[] = {kRunJsonFile,   kSeriesFile,  kSnapshotsFile,
+                                              kXdmfFile,      kProductFile, kBreakagesFile,
+                                              kCheckpointFile};
 inline constexpr const char* kOutputLockName = ".dem2d.lock";
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and
@@ -45,6 +47,18 @@ inline constexpr const char* kOutputLockName = ".dem2d.lock";
 //   - then the lock is created (exclusively: of two runs starting together one is refused).
 // The outcome is broadcast: on failure every rank throws IoError with the same text (the
 // reason and what to do: "give ... --output DIR", "--overwrite").
-OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, bool overwrite);
+// How a run takes its folder: a new run (refused if it holds another run's output), one that
+// replaces that output (--overwrite), or a restart that continues the output there (--restart:
+// a killed run's lock is taken over, the output kept).
+enum class Claim { kNew, kOverwrite, kContinue };
+OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, Claim how);
+
+// Collective, before a collective HDF5 write of about `bytes` to `path`: rank 0 checks the free
+// space of the file system that holds it (statvfs) and every rank throws the same IoError
+// "cannot write PATH: No space left on device (...)" when less than twice `bytes` is free.
+// Parallel HDF5 cannot recover from a write that fails on one rank and not on the others (the
+// ranks would wait for each other in different collectives), so a disk that fills is stopped
+// here, before the write; the files written so far stay whole.
+void ensure_free_space(MPI_Comm comm, const std::string& path, std::uint64_t bytes);
 
 }  // namespace dem2d

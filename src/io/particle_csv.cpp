@@ -22,12 +22,19 @@ using ColumnIndex = std::array<int, kColumns>;
 // Collects the messages about one file, and stops keeping them after kMaxCsvErrors.
 class CsvErrors {
  public:
-  CsvErrors(const std::string& shown, std::vector<std::string>& out) : shown_(shown), out_(out) {}
-  void at(int line, std::string_view message) {
-    if (++count_ <= kMaxCsvErrors) {
-      out_.push_back(line > 0 ? fmt::format("{}:{}: error: {}", shown_, line, message)
-                              : fmt::format("{}: error: {}", shown_, message));
-    }
+  CsvErrors(const std::string& shown, std::string_view key, CsvPacking& packing)
+      : shown_(shown),
+        row_(key.empty() ? std::string() : fmt::format("{} row: ", key)),
+        header_(key.empty() ? std::string() : fmt::format("{} header: ", key)),
+        out_(packing.errors),
+        file_(packing.file_errors) {}
+  // About a data row, or about the header row.
+  void at(int line, std::string_view message) { add(line, row_, message); }
+  void header(int line, std::string_view message) { add(line, header_, message); }
+  // About the file as a whole: the caller names the file and where the deck named it.
+  void file(std::string message) {
+    ++count_;
+    file_.push_back(std::move(message));
   }
   void finish() {
     if (count_ > kMaxCsvErrors) {
@@ -38,8 +45,15 @@ class CsvErrors {
   int count() const { return count_; }
 
  private:
+  void add(int line, const std::string& what, std::string_view message) {
+    if (++count_ <= kMaxCsvErrors)
+      out_.push_back(fmt::format("{}:{}: error: {}{}", shown_, line, what, message));
+  }
+
   const std::string& shown_;
+  std::string row_, header_;  // "fill[2].file row: ", "fill[2].file header: "; "" without a key
   std::vector<std::string>& out_;
+  std::vector<std::string>& file_;
   int count_ = 0;
 };
 
@@ -71,9 +85,9 @@ ColumnIndex read_header(const std::vector<std::string_view>& fields, int line, C
         message += fmt::format("; did you mean '{}'?", *near);
         suggested.push_back(*near);
       }
-      errors.at(line, message + " (columns: " + comma_list(deck::kCsvColumns) + ")");
+      errors.header(line, message + " (columns: " + comma_list(deck::kCsvColumns) + ")");
     } else if (int& slot = index[known - deck::kCsvColumns.begin()]; slot >= 0) {
-      errors.at(line, fmt::format("column '{}' appears twice", name));
+      errors.header(line, fmt::format("column '{}' appears twice", name));
     } else {
       slot = static_cast<int>(i);
     }
@@ -82,9 +96,9 @@ ColumnIndex read_header(const std::vector<std::string_view>& fields, int line, C
     const std::string_view name = deck::kCsvColumns[required];
     if (index[required] < 0 &&
         std::find(suggested.begin(), suggested.end(), name) == suggested.end()) {
-      errors.at(line, fmt::format("missing column '{}' (the header names x, y, radius and "
-                                  "optionally vx, vy, spin, material)",
-                                  name));
+      errors.header(line, fmt::format("missing column '{}' (the header names x, y, radius and "
+                                      "optionally vx, vy, spin, material)",
+                                      name));
     }
   }
   return index;
@@ -144,9 +158,9 @@ std::optional<ParticleSpec> read_row(const std::vector<std::string_view>& fields
 
 CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
                              const std::vector<std::string>& material_names,
-                             const CsvDefaults& defaults) {
+                             const CsvDefaults& defaults, std::string_view key) {
   CsvPacking packing;
-  CsvErrors errors(shown, packing.errors);
+  CsvErrors errors(shown, key, packing);
   if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);  // UTF-8 byte order mark
   std::optional<ColumnIndex> index;
   std::size_t n_fields = 0;
@@ -174,10 +188,10 @@ CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
     }
   }
   if (!index) {
-    errors.at(0, "empty file: expected a header row naming x, y, radius");
+    errors.file("is empty: expected a header row naming x, y, radius");
   } else if (packing.particles.empty() && errors.count() == 0 &&
              (packing.has_material_column || !defaults.material.empty())) {
-    errors.at(0, "no particles: the file has a header row but no rows");
+    errors.file("has a header row but no rows: no particles");
   }
   errors.finish();
   if (errors.count() > 0) packing.particles.clear();

@@ -22,19 +22,24 @@ struct CsvDefaults {
 
 struct CsvPacking {
   std::vector<ParticleSpec> particles;  // source_line = the line in the file
-  // Complete messages, "FILE:LINE: error: ..." (or "FILE: error: ..."); at most
-  // kMaxCsvErrors of them plus one line counting the rest.
+  // Complete messages, "FILE:LINE: error: ..."; at most kMaxCsvErrors of them plus one line
+  // "FILE: error: N more errors ..." counting the rest.
   std::vector<std::string> errors;
+  // What is wrong with the file as a whole, to follow its name ("is empty: ..."): the deck
+  // reports it at the key that named the file.
+  std::vector<std::string> file_errors;
   bool has_material_column = false;
 };
 
 inline constexpr int kMaxCsvErrors = 20;
 
-// Reads the text of one file; `shown` names it in messages, `material_names` are the deck's.
+// Reads the text of one file; `shown` names it in messages, `material_names` are the deck's,
+// `key` is the deck key that named the file ("fill[2].file"), which a message about a row or
+// the header names after the location ("packing.csv:7: error: fill[2].file row: ...").
 // Without a material column and without a default material, no row is read and no row error
 // is given: the caller reports that the fill needs a material.
 CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
                              const std::vector<std::string>& material_names,
-                             const CsvDefaults& defaults);
+                             const CsvDefaults& defaults, std::string_view key = {});
 
 }  // namespace dem2d

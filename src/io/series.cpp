@@ -4,7 +4,10 @@
 #include <fmt/ranges.h>  // fmt::join
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <iterator>
 #include <type_traits>
 
@@ -36,9 +39,51 @@ std::string series_columns_markdown() {
   return out;
 }
 
-SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active, bool ore)
+std::FILE* continue_csv(const std::string& path, const std::string& header, std::size_t column,
+                        double limit) {
+  std::ifstream in(path);
+  if (!in) {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    if (f == nullptr || std::fprintf(f, "%s\n", header.c_str()) < 0 || std::fflush(f) != 0)
+      throw IoError(fmt::format("cannot create {}: {}", path, std::strerror(errno)));
+    return f;
+  }
+  std::string line, kept;
+  if (!std::getline(in, line) || line != header)
+    throw IoError(
+        fmt::format("cannot continue {}: its columns are not this run's ({})", path, header));
+  kept = line + "\n";
+  while (std::getline(in, line)) {
+    std::size_t at = 0;  // where the column's value starts
+    for (std::size_t c = 0; c < column && at < line.size(); ++c) {
+      const std::size_t comma = line.find(',', at);
+      at = comma == std::string::npos ? line.size() : comma + 1;
+    }
+    if (at >= line.size()) break;  // a torn last row (a kill mid-write)
+    char* end = nullptr;
+    const double value = std::strtod(line.c_str() + at, &end);
+    if (end == line.c_str() + at || value > limit) break;
+    kept += line + "\n";
+  }
+  const std::string temporary = path + ".tmp";
+  std::FILE* out = std::fopen(temporary.c_str(), "w");
+  if (out == nullptr || std::fwrite(kept.data(), 1, kept.size(), out) != kept.size() ||
+      std::fclose(out) != 0 || std::rename(temporary.c_str(), path.c_str()) != 0)
+    throw IoError(fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  std::FILE* f = std::fopen(path.c_str(), "a");
+  if (f == nullptr) throw IoError(fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  return f;
+}
+
+SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active, bool ore,
+                           std::int64_t continue_after_step)
     : path_(path), iterative_(iterative), ore_(ore) {
   if (!active) return;
+  const std::string header = fmt::format("{}", fmt::join(series_columns(iterative_, ore_), ","));
+  if (continue_after_step >= 0) {
+    file_.reset(continue_csv(path_, header, 1, static_cast<double>(continue_after_step)));
+    return;
+  }
   file_.reset(std::fopen(path_.c_str(), "w"));
   if (!file_) throw IoError(fmt::format("cannot create {}: {}", path_, std::strerror(errno)));
   put(fmt::format("{}\n", fmt::join(series_columns(iterative_, ore_), ",")));

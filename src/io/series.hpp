@@ -97,11 +97,21 @@ std::vector<std::string> series_columns(bool iterative, bool ore = false);
 // "<!-- end columns -->"): header, separator and one line per column, each ending in '\n'.
 std::string series_columns_markdown();
 
+// A resumed run's CSV file (series.csv, product.csv, breakages.csv): keeps the header and the
+// rows whose value in column `column` is at most `limit` (the rows the interrupted run wrote
+// after its checkpoint go; the file is rewritten through a temporary renamed into place) and
+// returns it opened for appending; a missing file is created with the header. Throws IoError
+// when it cannot, or when the file's header is not `header` (another kind of run's file).
+std::FILE* continue_csv(const std::string& path, const std::string& header, std::size_t column,
+                        double limit);
+
 class SeriesWriter {
  public:
-  // Creates (truncating) `path` and writes the header row. Throws IoError
-  // "cannot create PATH: REASON" when it cannot (active writer only).
-  SeriesWriter(const std::string& path, bool iterative, bool active, bool ore = false);
+  // Creates (truncating) `path` and writes the header row; or, with `continue_after_step` >= 0
+  // (a restart), keeps the rows up to that step and appends after them (continue_csv). Throws
+  // IoError "cannot create PATH: REASON" when it cannot (active writer only).
+  SeriesWriter(const std::string& path, bool iterative, bool active, bool ore = false,
+               std::int64_t continue_after_step = -1);
   ~SeriesWriter();  // flushes and closes; never throws
   SeriesWriter(const SeriesWriter&) = delete;
   SeriesWriter& operator=(const SeriesWriter&) = delete;

@@ -1,6 +1,8 @@
 #include "io/snapshots.hpp"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -9,6 +11,7 @@
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 
@@ -27,6 +30,22 @@ const double* as_doubles(const Field<Vec2>& f) { return reinterpret_cast<const d
 
 // The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
 constexpr const char* kGeometry = "position";
+
+// The groups of snapshots.h5: complete snapshots, the one being written, the XDMF helpers.
+const std::string kSnapshotsGroup = "/snapshots";
+const std::string kStagingGroup = "/incomplete";
+const std::string kXdmfGroup = "/xdmf";
+
+// snapshots.xmf is kXdmfHeader, one grid per snapshot (xdmf_grid), kXdmfTrailer.
+constexpr std::string_view kXdmfHeader =
+    "<?xml version=\"1.0\" ?>\n"
+    "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+    "  <Domain>\n"
+    "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+constexpr std::string_view kXdmfTrailer =
+    "    </Grid>\n"
+    "  </Domain>\n"
+    "</Xdmf>\n";
 
 // A registry field as the writer sees it: its values, element type and values per particle.
 struct Column {
@@ -110,6 +129,65 @@ std::string point_attribute(const std::string& attribute, const std::string& h5_
 // The Xdmf3 readers make no cells without it (the points would not show as a surface).
 std::string polyvertex_dataset(std::uint64_t n) { return fmt::format("/xdmf/polyvertex_{}", n); }
 
+// The n of a member "polyvertex_n" of /xdmf; std::nullopt for another name.
+std::optional<std::uint64_t> polyvertex_size(const std::string& member) {
+  const std::string prefix = "polyvertex_";
+  if (!member.starts_with(prefix) || member.size() == prefix.size()) return std::nullopt;
+  const std::string digits = member.substr(prefix.size());
+  if (digits.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  return std::stoull(digits);
+}
+
+// The number of a snapshot group's name (NNNNNN); std::nullopt for any other name.
+std::optional<std::uint64_t> snapshot_index(const std::string& name) {
+  if (name.empty() || name.size() > 18 || name.find_first_not_of("0123456789") != std::string::npos)
+    return std::nullopt;
+  return std::stoull(name);
+}
+
+// The <Grid> of one snapshot in snapshots.xmf; `h5` is the HDF5 file's name.
+std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r) {
+  const std::string g = kSnapshotsGroup + "/" + r.name;
+  const std::uint64_t n = r.particles;
+  const std::string topology =
+      n == 0
+          ? "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"0\" NodesPerElement=\"1\"/>"
+          : fmt::format(
+                "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
+                "NodesPerElement=\"1\">\n          {}\n        </Topology>",
+                n, hdf_item(h5, polyvertex_dataset(n), n, 1, "Int", 8));
+  std::string text = fmt::format(
+      "      <Grid Name=\"snapshot_{}\" GridType=\"Uniform\">\n"
+      "        <Time Value=\"{:.17g}\"/>\n"
+      "        {}\n"
+      "        <Geometry GeometryType=\"XY\">\n"
+      "          {}\n"
+      "        </Geometry>\n",
+      r.name, r.time, topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
+  for (const SnapshotDataset& d : r.datasets) {
+    if (d.name == kGeometry) continue;
+    const auto [number_type, precision] = xdmf_number(d.type);
+    text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
+                            number_type, precision);
+  }
+  return text + "      </Grid>\n";
+}
+
+// Writes all of `text` at `offset` of the open file `fd`; false (errno set) on failure.
+bool write_at(int fd, std::string_view text, off_t offset) {
+  while (!text.empty()) {
+    const ssize_t n = ::pwrite(fd, text.data(), text.size(), offset);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      return false;
+    }
+    text.remove_prefix(static_cast<std::size_t>(n));
+    offset += n;
+  }
+  return true;
+}
+
 // Writes `text` to `path` through a temporary file and a rename, so that a reader never sees
 // a half-written file. Returns an error message, empty on success.
 std::string write_file_atomically(const std::string& path, const std::string& text) {
@@ -125,7 +203,10 @@ std::string write_file_atomically(const std::string& path, const std::string& te
   }
   std::error_code ec;
   fs::rename(tmp, path, ec);
-  if (ec) return fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message());
+  if (ec) {
+    std::remove(tmp.c_str());
+    return fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message());
+  }
   return {};
 }
 
@@ -144,12 +225,15 @@ std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles) {
   return out;
 }
 
+SnapshotWriter::SnapshotWriter(NoFile, MPI_Comm comm, const std::string& directory)
+    : comm_(comm),
+      rank_(mpi::rank(comm)),
+      h5_path_((fs::path(directory) / kSnapshotsFile).string()),
+      xdmf_path_((fs::path(directory) / kXdmfFile).string()) {}
+
 SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
                                const std::vector<MaterialSpec>& materials)
-    : comm_(comm),
-      h5_path_((fs::path(directory) / kSnapshotsFile).string()),
-      xdmf_path_((fs::path(directory) / kXdmfFile).string()) {
-  rank_ = mpi::rank(comm_);
+    : SnapshotWriter(NoFile{}, comm, directory) {
   // Rank 0 tries the path first with plain stdio: the usual failures (no such directory, not
   // writable) give a clear reason, and all ranks learn of them before the collective create.
   std::string error;
@@ -167,13 +251,40 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
   try {
     file_.emplace(h5::ParallelFile::create(comm_, h5_path_));
     write_materials(materials);
-    file_->create_group("/snapshots");
-    file_->create_group("/xdmf");
+    file_->create_group(kSnapshotsGroup);
+    file_->create_group(kStagingGroup);
+    file_->create_group(kXdmfGroup);
     file_->flush();
   } catch (const IoError& e) {
     error = e.what();
   }
   mpi::agree_on_failure<IoError>(comm_, error);
+}
+
+std::unique_ptr<SnapshotWriter> SnapshotWriter::resume(MPI_Comm comm, const std::string& directory,
+                                                       const std::vector<MaterialSpec>& materials,
+                                                       double time, double tolerance) {
+  const std::string path = (fs::path(directory) / kSnapshotsFile).string();
+  std::string found;
+  if (mpi::rank(comm) == 0) {
+    std::error_code ec;
+    if (fs::exists(path, ec)) found = "yes";
+  }
+  if (mpi::broadcast_string(comm, found, 0).empty())
+    return std::make_unique<SnapshotWriter>(comm, directory, materials);
+  std::unique_ptr<SnapshotWriter> w(new SnapshotWriter(NoFile{}, comm, directory));
+  std::string error;
+  try {
+    w->file_.emplace(h5::ParallelFile::open(comm, path));
+    w->drop_and_read(time + tolerance);
+    w->file_->flush();
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  w->agree(error);
+  if (w->rank_ == 0) error = w->rewrite_xdmf();
+  w->agree(error);
+  return w;
 }
 
 // Closes the file through the handle's destructor, which ignores (cannot report) a failure.
@@ -202,10 +313,9 @@ void SnapshotWriter::write_materials(const std::vector<MaterialSpec>& materials)
   column("normal_stiffness", &MaterialSpec::normal_stiffness);
 }
 
-void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
-                           std::span<const ExtraField> extra) {
-  if (!file_) throw std::logic_error("SnapshotWriter::write after close");
-  Record record{fmt::format("{:06d}", records_.size()), time, step, 0, snapshot_datasets(p)};
+SnapshotInfo SnapshotWriter::describe(const ParticleStore& p, double time, std::int64_t step,
+                                      std::span<const ExtraField> extra) const {
+  SnapshotInfo record{fmt::format("{:06d}", next_index_), time, step, 0, snapshot_datasets(p)};
   for (const ExtraField& e : extra) {
     const bool taken = std::any_of(record.datasets.begin(), record.datasets.end(),
                                    [&](const SnapshotDataset& d) { return d.name == e.name; });
@@ -213,36 +323,91 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
       throw std::invalid_argument("SnapshotWriter: bad extra field '" + e.name + "'");
     record.datasets.push_back({e.name, "double", 1, e.unit, e.doc});
   }
-  const std::string group = "/snapshots/" + record.name;
+  return record;
+}
+
+void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
+                           std::span<const ExtraField> extra) {
+  if (!file_) throw std::logic_error("SnapshotWriter::write after close");
+  SnapshotInfo record = describe(p, time, step, extra);
+  std::uint64_t row_bytes = 0;
+  for (const SnapshotDataset& d : record.datasets)
+    row_bytes += d.columns * (d.type == "int32" ? 4 : 8);
+  const std::uint64_t total = h5::row_range(comm_, p.n_owned()).total;
+  ensure_free_space(comm_, h5_path_, total * row_bytes + 2048 * record.datasets.size() + 16384);
+  const std::string staged = kStagingGroup + "/" + record.name;
+  const std::string published = kSnapshotsGroup + "/" + record.name;
   std::string error;
   try {
+    if (failed_) clear_failed_write(record.name);
     const h5::RowRange rows = h5::row_range(comm_, p.n_owned());
     record.particles = rows.total;
-    file_->create_group(group);
-    file_->write_attribute(group, "time", time);
-    file_->write_attribute(group, "step", step);
-    write_datasets(group, rows, p, extra);
-    if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) {
-      std::vector<std::int64_t> index(rows.count);
-      for (std::uint64_t i = 0; i < rows.count; ++i)
-        index[i] = static_cast<std::int64_t>(rows.offset + i);
-      file_->write_rows(polyvertex_dataset(rows.total), rows, index.data());
-      polyvertex_sizes_.insert(rows.total);
-    }
-    file_->flush();  // a crash later still leaves this snapshot readable
+    stage(staged, record, rows, p, extra);
   } catch (const IoError& e) {
     error = e.what();
   }
-  mpi::agree_on_failure<IoError>(comm_, error);
+  agree(error);
+  try {
+    file_->move_link(staged, published);  // complete: readers may see it from now on
+    file_->flush();                       // a crash later still leaves this snapshot readable
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  agree(error);
+  if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
   records_.push_back(std::move(record));
-  if (rank_ == 0) error = write_xdmf();
-  mpi::agree_on_failure<IoError>(comm_, error);
+  ++next_index_;
+  if (rank_ == 0) error = append_xdmf(records_.back());
+  agree(error);
+}
+
+void SnapshotWriter::agree(const std::string& local_error) {
+  std::string message = mpi::first_failure(comm_, local_error);
+  if (message.empty()) return;
+  failed_ = true;
+  throw IoError(message);
+}
+
+// Before the write after a failed one: removes what the failed write of snapshot `name` left
+// (its staging group; its published group if it failed after the move, before it was
+// recorded; a connectivity dataset no recorded snapshot uses), so the write can start afresh.
+void SnapshotWriter::clear_failed_write(const std::string& name) {
+  for (const std::string& g : {kStagingGroup + "/" + name, kSnapshotsGroup + "/" + name})
+    if (file_->link_exists(g)) file_->remove_link(g);
+  for (const std::string& member : file_->group_members(kXdmfGroup)) {
+    const std::optional<std::uint64_t> n = polyvertex_size(member);
+    if (n && !polyvertex_sizes_.contains(*n)) file_->remove_link(kXdmfGroup + "/" + member);
+  }
+  failed_ = false;
+}
+
+// The snapshot as the staging group `group`, with the connectivity it needs, flushed.
+void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
+                           const h5::RowRange& rows, const ParticleStore& p,
+                           std::span<const ExtraField> extra) {
+  file_->create_group(group, /*track_order=*/true);  // resume() reads the datasets in order
+  file_->write_attribute(group, "time", record.time);
+  file_->write_attribute(group, "step", record.step);
+  write_datasets(group, rows, p, extra);
+  if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) write_polyvertex(rows);
+  if (fail_before_dataset_) {  // testing: past the last dataset, fail before the flush
+    fail_before_dataset_.reset();
+    throw IoError(fmt::format("{}: cannot flush '{}': injected failure", h5_path_, group));
+  }
+  file_->flush();
 }
 
 // The registry's snapshot fields in registry order, then the extra fields; each dataset with
 // its unit and description as attributes, so a file explains itself.
 void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange& rows,
                                     const ParticleStore& p, std::span<const ExtraField> extra) {
+  std::size_t written = 0;
+  const auto begin = [&](const std::string& name) {  // fail_before_dataset_for_testing
+    if (fail_before_dataset_ && *fail_before_dataset_ == written++) {
+      fail_before_dataset_.reset();
+      throw IoError(fmt::format("{}: cannot write dataset '{}': injected failure", h5_path_, name));
+    }
+  };
   const auto describe = [&](const std::string& name, const std::string& unit,
                             const std::string& doc) {
     file_->write_attribute(name, "unit", unit);
@@ -251,13 +416,106 @@ void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange
   for (const FieldBase* f : p.fields()) {
     if (!f->meta().snapshot) continue;
     const std::string name = group + "/" + f->name();
+    begin(name);
     write_column(*file_, name, rows, *column_of(*f));  // snapshot_datasets checked the type
     describe(name, f->meta().unit, f->meta().doc);
   }
   for (const ExtraField& e : extra) {
     const std::string name = group + "/" + e.name;
+    begin(name);
     file_->write_rows(name, rows, e.values.data());
     describe(name, e.unit, e.doc);
+  }
+}
+
+// /xdmf/polyvertex_N for N = rows.total: 0, 1, ..., N - 1, each rank writing its rows.
+void SnapshotWriter::write_polyvertex(const h5::RowRange& rows) {
+  std::vector<std::int64_t> index(rows.count);
+  for (std::uint64_t i = 0; i < rows.count; ++i)
+    index[i] = static_cast<std::int64_t>(rows.offset + i);
+  file_->write_rows(polyvertex_dataset(rows.total), rows, index.data());
+}
+
+// resume(): empties /incomplete, drops the snapshots after `last_time`, records the others in
+// order and makes /xdmf hold exactly the connectivity they use.
+void SnapshotWriter::drop_and_read(double last_time) {
+  if (!file_->link_exists(kSnapshotsGroup))
+    throw IoError(fmt::format("{}: cannot resume: no {} group", h5_path_, kSnapshotsGroup));
+  if (file_->link_exists(kStagingGroup)) {
+    for (const std::string& m : file_->group_members(kStagingGroup))
+      file_->remove_link(kStagingGroup + "/" + m);
+  } else {
+    file_->create_group(kStagingGroup);
+  }
+  if (!file_->link_exists(kXdmfGroup)) file_->create_group(kXdmfGroup);
+  std::vector<std::pair<std::uint64_t, std::string>> groups;
+  for (const std::string& name : file_->group_members(kSnapshotsGroup)) {
+    const std::optional<std::uint64_t> index = snapshot_index(name);
+    if (!index)
+      throw IoError(fmt::format("{}: cannot resume: '{}/{}' is not a snapshot", h5_path_,
+                                kSnapshotsGroup, name));
+    groups.emplace_back(*index, name);
+  }
+  std::sort(groups.begin(), groups.end());
+  for (const auto& [index, name] : groups) {
+    std::optional<SnapshotInfo> record = read_record(name, last_time);
+    if (!record) {
+      file_->remove_link(kSnapshotsGroup + "/" + name);
+      continue;
+    }
+    records_.push_back(std::move(*record));
+    next_index_ = index + 1;
+  }
+  reconcile_polyvertex();
+}
+
+// The snapshot /snapshots/NAME as the file holds it; std::nullopt when its time is after
+// `last_time`. Throws IoError for a group that is not a snapshot dem2d wrote.
+std::optional<SnapshotInfo> SnapshotWriter::read_record(const std::string& name, double last_time) {
+  const std::string group = kSnapshotsGroup + "/" + name;
+  SnapshotInfo r{name, file_->read_double_attribute(group, "time"), 0, 0, {}};
+  if (r.time > last_time) return std::nullopt;
+  r.step = file_->read_int64_attribute(group, "step");
+  std::optional<std::uint64_t> rows;
+  for (const std::string& d : file_->group_members(group)) {
+    const std::string path = group + "/" + d;
+    const h5::ParallelFile::DatasetShape shape = file_->dataset_shape(path);
+    if (rows && *rows != shape.rows)
+      throw IoError(fmt::format("{}: cannot resume: '{}' has {} rows, not {}", h5_path_, path,
+                                shape.rows, *rows));
+    rows = shape.rows;
+    r.datasets.push_back({d, shape.type, shape.columns, file_->read_string_attribute(path, "unit"),
+                          file_->read_string_attribute(path, "doc")});
+  }
+  const bool has_geometry =
+      std::any_of(r.datasets.begin(), r.datasets.end(),
+                  [](const SnapshotDataset& d) { return d.name == kGeometry; });
+  if (!has_geometry)
+    throw IoError(
+        fmt::format("{}: cannot resume: '{}' has no {} dataset", h5_path_, group, kGeometry));
+  r.particles = *rows;
+  return r;
+}
+
+// resume(): keeps the /xdmf/polyvertex_N the kept snapshots use (an unused one may be what a
+// crash left half-written), removes the others and writes any that is missing.
+void SnapshotWriter::reconcile_polyvertex() {
+  std::set<std::uint64_t> used;
+  for (const SnapshotInfo& r : records_)
+    if (r.particles > 0) used.insert(r.particles);
+  for (const std::string& member : file_->group_members(kXdmfGroup)) {
+    const std::optional<std::uint64_t> n = polyvertex_size(member);
+    if (!n) continue;
+    const std::string path = kXdmfGroup + "/" + member;
+    if (used.contains(*n) && file_->dataset_shape(path).rows == *n)
+      polyvertex_sizes_.insert(*n);
+    else
+      file_->remove_link(path);
+  }
+  for (const std::uint64_t n : used) {
+    if (polyvertex_sizes_.contains(n)) continue;
+    write_polyvertex(h5::rank0_rows(comm_, n));
+    polyvertex_sizes_.insert(n);
   }
 }
 
@@ -273,44 +531,43 @@ void SnapshotWriter::close() {
   mpi::agree_on_failure<IoError>(comm_, error);
 }
 
-std::string SnapshotWriter::write_xdmf() const {
-  const std::string h5 = fs::path(h5_path_).filename().string();
-  std::string text =
-      "<?xml version=\"1.0\" ?>\n"
-      "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
-      "  <Domain>\n"
-      "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-  for (const Record& r : records_) {
-    const std::string g = "/snapshots/" + r.name;
-    const std::uint64_t n = r.particles;
-    const std::string topology =
-        n == 0
-            ? "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"0\" NodesPerElement=\"1\"/>"
-            : fmt::format(
-                  "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
-                  "NodesPerElement=\"1\">\n          {}\n        </Topology>",
-                  n, hdf_item(h5, polyvertex_dataset(n), n, 1, "Int", 8));
-    text += fmt::format(
-        "      <Grid Name=\"snapshot_{}\" GridType=\"Uniform\">\n"
-        "        <Time Value=\"{:.17g}\"/>\n"
-        "        {}\n"
-        "        <Geometry GeometryType=\"XY\">\n"
-        "          {}\n"
-        "        </Geometry>\n",
-        r.name, r.time, topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
-    for (const SnapshotDataset& d : r.datasets) {
-      if (d.name == kGeometry) continue;
-      const auto [number_type, precision] = xdmf_number(d.type);
-      text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
-                              number_type, precision);
-    }
-    text += "      </Grid>\n";
+std::string SnapshotWriter::rewrite_xdmf() {
+  xmf_trailer_.reset();
+  if (records_.empty()) {  // nothing to show
+    std::error_code ec;
+    fs::remove(xdmf_path_, ec);
+    return ec ? fmt::format("cannot remove {}: {}", xdmf_path_, ec.message()) : std::string();
   }
-  text +=
-      "    </Grid>\n"
-      "  </Domain>\n"
-      "</Xdmf>\n";
-  return write_file_atomically(xdmf_path_, text);
+  const std::string h5 = fs::path(h5_path_).filename().string();
+  std::string text(kXdmfHeader);
+  for (const SnapshotInfo& r : records_) text += xdmf_grid(h5, r);
+  const auto trailer_at = static_cast<long>(text.size());
+  text += kXdmfTrailer;
+  std::string error = write_file_atomically(xdmf_path_, text);
+  if (error.empty()) xmf_trailer_ = trailer_at;
+  return error;
+}
+
+// O(1): the new grid and the trailer over the old trailer. On a failure the old trailer is put
+// back and the file cut after it (best effort), and the next snapshot rewrites the file whole.
+std::string SnapshotWriter::append_xdmf(const SnapshotInfo& record) {
+  if (!xmf_trailer_) return rewrite_xdmf();  // the first snapshot, or after a failure
+  const int fd = ::open(xdmf_path_.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return rewrite_xdmf();  // removed meanwhile: made anew
+  const auto at = static_cast<off_t>(*xmf_trailer_);
+  xmf_trailer_.reset();  // until the write succeeded
+  const std::string grid = xdmf_grid(fs::path(h5_path_).filename().string(), record);
+  bool ok = write_at(fd, grid + std::string(kXdmfTrailer), at);
+  int error = errno;
+  if (!ok && write_at(fd, kXdmfTrailer, at))
+    (void)!::ftruncate(fd, at + static_cast<off_t>(kXdmfTrailer.size()));
+  if (::close(fd) != 0 && ok) {
+    ok = false;
+    error = errno;
+  }
+  if (!ok) return fmt::format("cannot write {}: {}", xdmf_path_, std::strerror(error));
+  xmf_trailer_ = static_cast<long>(at) + static_cast<long>(grid.size());
+  return {};
 }
 
 }  // namespace dem2d

@@ -112,14 +112,19 @@ std::optional<std::string_view> closest_match(std::string_view word,
   std::optional<std::string_view> best;
   std::size_t best_distance = std::numeric_limits<std::size_t>::max();
   const std::string lower = lowercase(word);
+  const std::size_t limit = std::max<std::size_t>(1, word.size() / 3);
   for (const std::string_view candidate : candidates) {
+    // The distance is at least the difference in length: a candidate too short or too long is
+    // skipped before its table is built (a 30 000-character key would need gigabytes).
+    const std::size_t gap = lower.size() > candidate.size() ? lower.size() - candidate.size()
+                                                            : candidate.size() - lower.size();
+    if (gap > limit) continue;
     const std::size_t distance = edit_distance(lower, lowercase(candidate));
     if (distance < best_distance) {
       best = candidate;
       best_distance = distance;
     }
   }
-  const std::size_t limit = std::max<std::size_t>(1, word.size() / 3);
   if (best && best_distance <= limit) return best;
   return std::nullopt;
 }

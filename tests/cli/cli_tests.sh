@@ -78,12 +78,12 @@ grep -q '"ranks": 2' "$tmp/drop/run.json" && pass "run.json records 2 ranks" || 
 # the first run's output untouched) unless --overwrite; a folder in use is refused even then.
 sum_before=$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")
 for np in 1 2; do
-  expect "np$np second run into one folder refused" 2 "^--output $tmp/drop: error: output directory '$tmp/drop' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf\); give this run a new folder with --output DIR, or --overwrite" -- \
+  expect "np$np second run into one folder refused" 2 "^--output $tmp/drop: error: output directory '$tmp/drop' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf, checkpoint\.h5\); give this run a new folder with --output DIR, or --overwrite" -- \
     mpirun -np "$np" --oversubscribe "$dem2d" "$src/inputs/drop.in" --set run.duration=0.05 --output "$tmp/drop"
 done
 [ "$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")" = "$sum_before" ] \
   && pass "refused runs left the first run's output as it was" || fail "a refused run touched the first run's output"
-expect "deck's folder refused names the key" 2 "drop\.in: error: output\.directory = '.*': output directory .* holds another run's output" -- \
+expect "deck's folder refused names the key" 2 "^--set output\.directory=.*: error: output\.directory = '.*': output directory .* holds another run's output" -- \
   "$dem2d" --quiet "$src/inputs/drop.in" --set run.duration=0.05 --set "output.directory=$tmp/drop"
 expect "--overwrite replaces the output" 0 'done: 0.05 s simulated' -- "$dem2d" "$src/inputs/drop.in" \
   --set run.duration=0.05 --output "$tmp/drop" --overwrite
@@ -197,6 +197,19 @@ done
 expect "guards warn: the motion guard still stops" 3 'error: the run became unstable at step 140 .*moves [0-9.e+-]+ times its radius' -- \
   "$dem2d" "$src/inputs/centrifuge.in" --quiet --set run.dt=5e-4 --set run.allow_unsafe_dt=true \
   --set run.duration=0.3 --set run.guards=warn --output "$tmp/warn_motion"
+
+# A particle that leaves the drum during the run (a soft ball sinking through the shell, the
+# overlap guard only warning) stops it with exit 3 naming the particle, alike on 1 and 3 ranks.
+printf '%s\n' 'title = "a soft ball sinks through the shell"' '[run]' 'duration = 3.0' 'dt = 1.0e-4' \
+  'guards = "warn"' '[[material]]' 'name = "soft"' 'density = 1000.0' 'youngs_modulus = 1.0e3' \
+  'poisson_ratio = 0.3' 'restitution = 0.5' 'sliding_friction = 0.3' '[drum]' 'radius = 1.0' \
+  'speed = 0.0' 'material = "soft"' '[[particle]]' 'material = "soft"' 'radius = 0.1' \
+  'position = [0.0, -0.85]' >"$tmp/escape.in"
+for np in 1 3; do
+  expect "np$np particle leaving the drum exits 3 with its id" 3 \
+    'escape\.in: error: the run became unstable at step 1858 \(t = 0\.1858 s\): particle 0 left the drum: its centre is 1\.01[0-9]* m from the drum.s centre, beyond the shell at 1 m' -- \
+    mpirun -np "$np" --oversubscribe "$dem2d" "$tmp/escape.in" --quiet --output "$tmp/escape$np"
+done
 
 echo "cli: $failures failure(s)"
 [ "$failures" -eq 0 ]

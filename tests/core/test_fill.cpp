@@ -183,7 +183,7 @@ TEST(Fill, TooManyParticlesIsAnInputErrorNamingTheDeckLine) {
     place_particles(s, walls, p);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("test.in:7: error: [[fill]]: 5000 particles do not fit"),
+    EXPECT_NE(std::string(e.what()).find("test.in:7: error: fill[0]: 5000 particles do not fit"),
               std::string::npos)
         << e.what();
   }

@@ -370,12 +370,16 @@ TEST(Stability, BodiesCannotPassThroughEachOtherUnseen) {
   for (const IntegratorKind integrator : {IntegratorKind::kVerlet, IntegratorKind::kIterative}) {
     Scene s = base_scene(integrator);
     s.run.gravity = {0.0, 0.0};
-    add_ball(s, {-0.2, 0.0}, {100.0, 0.0}, 0.05);
-    add_ball(s, {0.2, 0.0}, {-100.0, 0.0}, 0.05);
+    add_ball(s, {-0.2, 0.0}, {0.0, 0.0}, 0.05);
+    add_ball(s, {0.2, 0.0}, {0.0, 0.0}, 0.05);
     s.run.dt_auto = false;
     s.run.dt = 5.0e-4;  // 100 m/s x 5e-4 s = 0.05 m: one radius per step
     s.run.allow_unsafe_dt = true;
     Simulation sim(s);
+    // Set after the start: such initial velocities are bad input (validate_start), so the
+    // guard is met by a state the run reached.
+    sim.particles().vel[0] = {100.0, 0.0};
+    sim.particles().vel[1] = {-100.0, 0.0};
     std::string what;
     std::int64_t step = -1;
     try {

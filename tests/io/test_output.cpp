@@ -6,6 +6,7 @@
 #include <hdf5.h>
 #include <mpi.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bit>
@@ -17,6 +18,7 @@
 #include <functional>
 #include <limits>
 #include <set>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -596,6 +598,255 @@ TEST(SnapshotWriter, UnwritableDirectoryFailsOnEveryRank) {
       "cannot create " + missing + "/snapshots.h5: No such file or directory");
 }
 
+// --- complete or absent snapshots, the sidecar appended in place, resume ------------------
+
+const std::string kXdmfTrailer = "    </Grid>\n  </Domain>\n</Xdmf>\n";
+
+// Writes particles [0, n) of `version`, in blocks over the ranks, at `time` (step 1000 x
+// version), with the extra field `damage` when asked.
+void write_version(SnapshotWriter& w, int n, int version, double time, bool with_damage = false) {
+  ParticleStore p;
+  const std::vector<double> dmg = fill(p, n, version, [n](int k) { return block_owner(k, n); });
+  const ExtraField extra[] = {{"damage", dmg}};
+  w.write(p, time, 1000 * version,
+          with_damage ? std::span<const ExtraField>(extra) : std::span<const ExtraField>());
+}
+
+std::uint64_t inode(const std::string& path) {
+  struct stat s {};
+  return ::stat(path.c_str(), &s) == 0 ? static_cast<std::uint64_t>(s.st_ino) : 0;
+}
+
+// The `Time Value`s of a sidecar, as numbers.
+std::vector<double> xdmf_times(const std::string& xmf) {
+  std::vector<double> out;
+  for (const std::string& v : attribute_values(xmf, "Value"))
+    out.push_back(std::strtod(v.c_str(), nullptr));
+  return out;
+}
+
+// A write that fails part-way (as on a full disk; fail_before_dataset_for_testing stands in for
+// the disk) leaves its partial group under /incomplete, never under /snapshots, and the sidecar
+// lists only the complete snapshots. Failing before the first dataset, in the middle, and after
+// the last (before the flush and the move).
+TEST(SnapshotWriter, FailedWriteLeavesOnlyCompleteSnapshots) {
+  const std::size_t datasets = snapshot_datasets(ParticleStore{}).size();
+  for (const std::size_t k : {std::size_t{0}, std::size_t{3}, datasets}) {
+    SCOPED_TRACE("failing before dataset " + std::to_string(k));
+    ScratchDir dir;
+    const int n = 5;
+    {
+      SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+      write_version(writer, n, 0, 0.1);
+      writer.fail_before_dataset_for_testing(k);
+      expect_same_io_error_everywhere([&] { write_version(writer, n + 2, 1, 0.2); },
+                                      dir / "snapshots.h5" + ": cannot ");
+      EXPECT_EQ(writer.snapshots_written(), 1u);
+      writer.close();
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (comm_rank() != 0) continue;
+    H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+    ASSERT_GE(file.id, 0);
+    EXPECT_EQ(group_members(file.id, "/snapshots"), (std::set<std::string>{"000000"}));
+    check_snapshot(file.id, "000000", n, 0, 0.1, 0);
+    // The partial group: outside /snapshots, with the datasets written before the failure.
+    EXPECT_EQ(group_members(file.id, "/incomplete"), (std::set<std::string>{"000001"}));
+    EXPECT_EQ(group_members(file.id, "/incomplete/000001").size(), k);
+    const std::string xmf = read_text(dir / "snapshots.xmf");
+    EXPECT_EQ(xml_problem(xmf), "");
+    EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), 1u);
+    EXPECT_EQ(count(xmf, "/000001"), 0u);
+  }
+}
+
+// After a failed write the writer goes on: the next write removes the remains (the staging
+// group, a connectivity dataset written for it) and takes the failed snapshot's number.
+TEST(SnapshotWriter, AWriteAfterAFailedOneTakesItsNumber) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1);
+    // Every dataset and /xdmf/polyvertex_7 written, then the flush fails.
+    writer.fail_before_dataset_for_testing(snapshot_datasets(ParticleStore{}).size());
+    EXPECT_THROW(write_version(writer, 7, 1, 0.2), IoError);
+    write_version(writer, 7, 2, 0.3, true);
+    ASSERT_EQ(writer.snapshots_written(), 2u);
+    EXPECT_EQ(writer.snapshots()[1].name, "000001");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(group_members(file.id, "/snapshots"), (std::set<std::string>{"000000", "000001"}));
+  check_snapshot(file.id, "000000", 5, 0, 0.1, 0);
+  check_snapshot(file.id, "000001", 7, 2, 0.3, 2000);
+  EXPECT_GT(H5Lexists(file.id, "/snapshots/000001/damage", H5P_DEFAULT), 0);
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  Dims dims;
+  EXPECT_EQ(read_dataset<std::int64_t>(file.id, "/xdmf/polyvertex_7", H5T_NATIVE_INT64, dims),
+            (std::vector<std::int64_t>{0, 1, 2, 3, 4, 5, 6}));
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_EQ(xdmf_times(xmf), (std::vector<double>{0.1, 0.3}));
+}
+
+// Each snapshot appends its grid in place (the same file, the old text less its trailer kept
+// as it was), the sidecar is valid after every write, and after five appends it is, byte for
+// byte, the sidecar regenerated from the file's groups (resume() keeping them all).
+TEST(SnapshotWriter, SidecarIsAppendedInPlaceAndEqualsTheRegeneratedOne) {
+  ScratchDir dir;
+  const std::string path = dir / "snapshots.xmf";
+  const int counts[] = {5, 5, 0, 3, 5};
+  std::string appended;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    std::uint64_t created = 0;
+    for (int v = 0; v < 5; ++v) {
+      write_version(writer, counts[v], v, 0.1 * (v + 1), v == 3);
+      if (comm_rank() != 0) continue;
+      SCOPED_TRACE("after snapshot " + std::to_string(v));
+      const std::string xmf = read_text(path);
+      EXPECT_EQ(xml_problem(xmf), "");
+      EXPECT_TRUE(xmf.ends_with(kXdmfTrailer));
+      EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), static_cast<std::size_t>(v + 1));
+      if (v == 0) {
+        created = inode(path);
+      } else {
+        EXPECT_EQ(inode(path), created) << "written in place, not replaced";
+        EXPECT_TRUE(xmf.starts_with(appended.substr(0, appended.size() - kXdmfTrailer.size())));
+      }
+      appended = xmf;
+    }
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  {
+    const auto all = SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 1e300, 0.0);
+    EXPECT_EQ(all->snapshots_written(), 5u);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  const std::string regenerated = read_text(path);
+  EXPECT_EQ(regenerated, appended);
+  EXPECT_EQ(xdmf_times(regenerated), (std::vector<double>{0.1, 0.2, 0.1 * 3, 0.4, 0.5}));
+  EXPECT_EQ(count(regenerated, "Name=\"damage\""), 1u);
+  EXPECT_EQ(count(regenerated, "NumberOfElements=\"0\""), 1u);
+}
+
+// A restart from a checkpoint at t = 0.3: the snapshots the interrupted run wrote after it
+// (and its half-written one) go, the sidecar lists the kept ones exactly as it did when the
+// last of them was written, and the next snapshot continues the numbering.
+TEST(SnapshotWriter, ResumeDropsTheSnapshotsAfterTheCheckpointAndContinues) {
+  ScratchDir dir;
+  std::string at_checkpoint;  // the sidecar just after the checkpoint's snapshot
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    for (int v = 0; v < 5; ++v) {
+      write_version(writer, v < 3 ? 5 : 6, v, 0.1 * (v + 1));
+      if (v == 2 && comm_rank() == 0) at_checkpoint = read_text(dir / "snapshots.xmf");
+    }
+    writer.fail_before_dataset_for_testing(2);  // interrupted: /incomplete/000005 is left
+    EXPECT_THROW(write_version(writer, 6, 5, 0.6), IoError);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  {
+    // A hair before 0.1 * 3: the tolerance keeps 000002.
+    const auto writer = SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 0.3 - 1e-12, 1e-9);
+    ASSERT_EQ(writer->snapshots_written(), 3u);
+    EXPECT_EQ(writer->snapshots().back().name, "000002");
+    EXPECT_EQ(writer->snapshots().back().time, 0.1 * 3);
+    EXPECT_EQ(writer->snapshots().back().step, 2000);
+    EXPECT_EQ(writer->snapshots().back().particles, 5u);
+    if (comm_rank() == 0) {
+      EXPECT_EQ(read_text(dir / "snapshots.xmf"), at_checkpoint);
+    }
+    write_version(*writer, 5, 9, 0.35);
+    EXPECT_EQ(writer->snapshots().back().name, "000003");
+    writer->close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(group_members(file.id, "/snapshots"),
+            (std::set<std::string>{"000000", "000001", "000002", "000003"}));
+  for (int v = 0; v < 3; ++v)
+    check_snapshot(file.id, "00000" + std::to_string(v), 5, v, 0.1 * (v + 1), 1000 * v);
+  check_snapshot(file.id, "000003", 5, 9, 0.35, 9000);
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  // The dropped snapshots' connectivity is gone with them.
+  EXPECT_EQ(group_members(file.id, "/xdmf"), (std::set<std::string>{"polyvertex_5"}));
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_TRUE(xmf.starts_with(at_checkpoint.substr(0, at_checkpoint.size() - kXdmfTrailer.size())));
+  EXPECT_EQ(xdmf_times(xmf), (std::vector<double>{0.1, 0.2, 0.1 * 3, 0.35}));
+  EXPECT_EQ(count(xmf, "polyvertex_6"), 0u);
+}
+
+TEST(SnapshotWriter, ResumeWithoutAFileCreatesIt) {
+  ScratchDir dir;
+  {
+    const auto writer =
+        SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), test_materials(), 1.0, 1e-9);
+    EXPECT_EQ(writer->snapshots_written(), 0u);
+    write_version(*writer, 4, 0, 1.5);
+    EXPECT_EQ(writer->snapshots().front().name, "000000");
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(read_strings(file.id, "/materials/name"),
+            (std::vector<std::string>{"steel", "iron ore", "rubber-liner"}));
+  check_snapshot(file.id, "000000", 4, 0, 1.5, 0);
+  EXPECT_EQ(xdmf_times(read_text(dir / "snapshots.xmf")), (std::vector<double>{1.5}));
+}
+
+TEST(SnapshotWriter, ResumeOfAFileThatIsNotASnapshotFileFailsOnEveryRank) {
+  ScratchDir dir;
+  const std::string h5 = dir / "snapshots.h5";
+  if (comm_rank() == 0) std::ofstream(h5) << "not an HDF5 file";
+  MPI_Barrier(MPI_COMM_WORLD);
+  const auto resume = [&] { SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 1.0, 0.0); };
+  expect_same_io_error_everywhere(resume, "cannot open " + h5 + ": ");
+  {
+    auto f = h5::ParallelFile::create(MPI_COMM_WORLD, h5);  // HDF5, but no /snapshots
+    f.create_group("/other");
+    f.close();
+  }
+  expect_same_io_error_everywhere(resume, h5 + ": cannot resume: no /snapshots group");
+}
+
+// A sidecar that cannot be written is an IoError; the snapshot is in snapshots.h5 all the same,
+// and the next write makes the sidecar anew, listing it.
+TEST(SnapshotWriter, SidecarFailureIsReportedAndTheNextWriteRewritesIt) {
+  ScratchDir dir;
+  const std::string xmf = dir / "snapshots.xmf";
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 3, 0, 0.1);
+    if (comm_rank() == 0) {
+      fs::remove(xmf);
+      fs::create_directory(xmf);  // neither opened nor replaced by a rename
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    expect_same_io_error_everywhere([&] { write_version(writer, 3, 1, 0.2); },
+                                    "cannot rename " + xmf + ".tmp to " + xmf + ": ");
+    EXPECT_EQ(writer.snapshots_written(), 2u);
+    if (comm_rank() == 0) {
+      EXPECT_FALSE(fs::exists(xmf + ".tmp"));
+      fs::remove(xmf);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    write_version(writer, 3, 2, 0.3);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  const std::string text = read_text(xmf);
+  EXPECT_EQ(xml_problem(text), "");
+  EXPECT_EQ(xdmf_times(text), (std::vector<double>{0.1, 0.2, 0.3}));
+}
+
 TEST(ParallelFile, ErrorsNameTheFileAndTheObject) {
   ScratchDir dir;
   const std::string missing = dir / "no/such/t.h5";  // MPI-IO's own open fails on every rank
@@ -753,16 +1004,16 @@ TEST(OutputDirectory, CreatesNestedDirectoriesAndLocksThemWhileTheRunLasts) {
   const std::string out = dir / "a/b/c";
   const std::string lock = out + "/" + kOutputLockName;
   {
-    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, false);
+    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, Claim::kNew);
     MPI_Barrier(MPI_COMM_WORLD);
     EXPECT_TRUE(fs::is_directory(out));
     EXPECT_TRUE(fs::exists(lock));  // and nothing else: the write probe is gone
     EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 1);
     MPI_Barrier(MPI_COMM_WORLD);  // every rank looked before rank 0 probes again
     // This process is running: a second claim is refused, --overwrite or not.
-    for (const bool overwrite : {false, true})
+    for (const Claim how : {Claim::kNew, Claim::kOverwrite, Claim::kContinue})
       expect_same_io_error_everywhere(
-          [&] { claim_output_directory(MPI_COMM_WORLD, out, overwrite); },
+          [&] { claim_output_directory(MPI_COMM_WORLD, out, how); },
           "output directory '" + out + "' is in use by a dem2d run that is still running (pid ");
     EXPECT_TRUE(fs::exists(lock));  // the refused claims left the holder's lock alone
     MPI_Barrier(MPI_COMM_WORLD);
@@ -770,7 +1021,7 @@ TEST(OutputDirectory, CreatesNestedDirectoriesAndLocksThemWhileTheRunLasts) {
   MPI_Barrier(MPI_COMM_WORLD);
   EXPECT_FALSE(fs::exists(lock));  // released when the run ends
   MPI_Barrier(MPI_COMM_WORLD);
-  claim_output_directory(MPI_COMM_WORLD, out, false);  // an empty folder: fine again
+  claim_output_directory(MPI_COMM_WORLD, out, Claim::kNew);  // an empty folder: fine again
 }
 
 TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
@@ -785,7 +1036,7 @@ TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
   }
   MPI_Barrier(MPI_COMM_WORLD);
   expect_same_io_error_everywhere(
-      [&] { claim_output_directory(MPI_COMM_WORLD, out, false); },
+      [&] { claim_output_directory(MPI_COMM_WORLD, out, Claim::kNew); },
       "output directory '" + out + "' holds another run's output (" + kOutputLockName +
           " of a run that did not end (pid 4194305 on host " + host() +
           "), series.csv, "
@@ -794,7 +1045,7 @@ TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
   MPI_Barrier(MPI_COMM_WORLD);
   EXPECT_TRUE(fs::exists(out + "/series.csv"));  // refused: nothing touched
   {
-    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, true);
+    const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, Claim::kOverwrite);
     MPI_Barrier(MPI_COMM_WORLD);
     EXPECT_FALSE(fs::exists(out + "/series.csv"));  // the old output is gone, not mixed in
     EXPECT_FALSE(fs::exists(out + "/snapshots.h5"));
@@ -806,17 +1057,17 @@ TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
 TEST(OutputDirectory, UnwritableIsTheSameIoErrorOnEveryRank) {
   ScratchDir dir;
   expect_same_io_error_everywhere(
-      [] { claim_output_directory(MPI_COMM_WORLD, "/proc/dem2d_no", false); },
+      [] { claim_output_directory(MPI_COMM_WORLD, "/proc/dem2d_no", Claim::kNew); },
       "cannot write to output directory '/proc/dem2d_no': ");
   if (comm_rank() == 0) std::ofstream(dir / "plain_file") << "x";
   MPI_Barrier(MPI_COMM_WORLD);
   const std::string under_file = dir / "plain_file/sub";
   expect_same_io_error_everywhere(
-      [&] { claim_output_directory(MPI_COMM_WORLD, under_file, false); },
+      [&] { claim_output_directory(MPI_COMM_WORLD, under_file, Claim::kNew); },
       "cannot write to output directory '" + under_file + "': ");
   const std::string file_itself = dir / "plain_file";
   expect_same_io_error_everywhere(
-      [&] { claim_output_directory(MPI_COMM_WORLD, file_itself, false); },
+      [&] { claim_output_directory(MPI_COMM_WORLD, file_itself, Claim::kNew); },
       "cannot write to output directory '" + file_itself + "': ");
 }
 

@@ -441,7 +441,7 @@ TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
   s.materials.push_back(ore);
   s.run.dt_auto = true;
   s.drum.present = true;
-  s.drum.radius = 0.3;
+  s.drum.radius = 0.375;  // the fill boxes' corners inside the 8-gon's inscribed circle
   s.drum.speed = 6.0;
   s.drum.sides = 8;
   s.drum.material = "steel";

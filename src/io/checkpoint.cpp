@@ -1,0 +1,418 @@
+#include "io/checkpoint.hpp"
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "io/deck.hpp"
+#include "io/hdf5.hpp"
+#include "io/output_dir.hpp"
+#include "io/text.hpp"
+
+namespace dem2d {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The scalars of a RunState as root attributes: the name and where the value lives.
+struct RealAttribute {
+  const char* name;
+  double RunState::*member;
+};
+struct CountAttribute {
+  const char* name;
+  std::int64_t RunState::*member;
+};
+constexpr RealAttribute kReals[] = {{"time", &RunState::time},
+                                    {"dt", &RunState::dt},
+                                    {"skin", &RunState::skin},
+                                    {"halo_width", &RunState::halo_width},
+                                    {"balance0", &RunState::balance0},
+                                    {"motion0", &RunState::motion0},
+                                    {"potential0", &RunState::potential0},
+                                    {"energy_floor", &RunState::energy_floor}};
+constexpr CountAttribute kCounts[] = {{"step", &RunState::step},
+                                      {"neighbor_builds", &RunState::neighbor_builds}};
+
+// The pass counters and the grinding state, flattened (name, value) both ways.
+std::vector<std::pair<const char*, std::int64_t*>> count_slots(RunState& s) {
+  GrindingState& g = s.grinding;
+  return {{"passes_total", &s.passes.total},
+          {"passes_since_row", &s.passes.since_row},
+          {"passes_steps_since_row", &s.passes.steps_since_row},
+          {"unconverged_steps", &s.passes.unconverged_steps},
+          {"next_id", &g.next_id},
+          {"births_from", &g.births_from},
+          {"breakages", &g.totals.breakages},
+          {"fragments", &g.totals.fragments},
+          {"fed_count", &g.totals.fed_count},
+          {"discharged_count", &g.totals.discharged_count}};
+}
+std::vector<std::pair<const char*, double*>> real_slots(RunState& s) {
+  GrindingState& g = s.grinding;
+  return {{"next_feed_try", &g.next_feed_try},
+          {"fed_mass", &g.totals.fed_mass},
+          {"discharged_mass", &g.totals.discharged_mass}};
+}
+// The per-rank shares (/ranks/NAME).
+std::vector<std::pair<const char*, double*>> share_slots(RunState& s) {
+  return {{"dissipated", &s.rank_dissipated},
+          {"drive_work", &s.rank_drive_work},
+          {"fed_energy", &s.grinding.rank_fed_energy},
+          {"discharged_energy", &s.grinding.rank_discharged_energy}};
+}
+
+void write_field(h5::ParallelFile& file, const std::string& name, const h5::RowRange& rows,
+                 const FieldBase& f) {
+  if (const auto* d = dynamic_cast<const Field<double>*>(&f))
+    return file.write_rows(name, rows, d->data());
+  if (const auto* v = dynamic_cast<const Field<Vec2>*>(&f))
+    return file.write_rows(name, rows, reinterpret_cast<const double*>(v->data()), 2);
+  if (const auto* i = dynamic_cast<const Field<std::int64_t>*>(&f))
+    return file.write_rows(name, rows, i->data());
+  if (const auto* i = dynamic_cast<const Field<std::int32_t>*>(&f))
+    return file.write_rows(name, rows, i->data());
+  throw std::logic_error("checkpoint: particle field " + f.name() + " has no HDF5 type");
+}
+
+// The memory type a field is read back with (a Vec2 is two doubles).
+hid_t memory_type(const FieldBase& f) {
+  if (dynamic_cast<const Field<std::int64_t>*>(&f)) return H5T_NATIVE_INT64;
+  if (dynamic_cast<const Field<std::int32_t>*>(&f)) return H5T_NATIVE_INT32;
+  return H5T_NATIVE_DOUBLE;
+}
+
+void write_state(h5::ParallelFile& file, const Simulation& sim, int ranks) {
+  RunState s = sim.run_state();
+  file.write_attribute("/", "format", std::string(kCheckpointFormat));
+  file.write_attribute("/", "version", std::string(DEM2D_VERSION));
+  file.write_attribute("/", "ranks", static_cast<std::int64_t>(ranks));
+  file.write_attribute("/", "baseline_taken", static_cast<std::int64_t>(s.baseline_taken));
+  file.write_attribute("/", "passes_last", static_cast<std::int64_t>(s.passes.last));
+  for (const RealAttribute& a : kReals) file.write_attribute("/", a.name, s.*a.member);
+  for (const CountAttribute& a : kCounts) file.write_attribute("/", a.name, s.*a.member);
+  for (auto [name, value] : count_slots(s)) file.write_attribute("/", name, *value);
+  for (auto [name, value] : real_slots(s)) file.write_attribute("/", name, *value);
+  file.write_strings("/deck", {resolved_deck_toml(sim.scene())});
+  file.create_group("/ranks");
+  const h5::RowRange one = h5::row_range(file.comm(), 1);
+  for (auto [name, value] : share_slots(s))
+    file.write_rows(std::string("/ranks/") + name, one, value);
+  file.create_group("/guards");
+  std::vector<std::string> kinds, firsts;
+  std::vector<std::int64_t> counts;
+  for (const GuardRecord& g : s.guards) {
+    kinds.push_back(g.kind);
+    counts.push_back(g.count);
+    firsts.push_back(g.first);
+  }
+  file.write_strings("/guards/kind", kinds);
+  file.write_strings("/guards/first", firsts);
+  file.write_rows("/guards/count", h5::rank0_rows(file.comm(), counts.size()), counts.data());
+}
+
+void write_particles(h5::ParallelFile& file, const ParticleStore& p) {
+  file.create_group("/particles");
+  const h5::RowRange rows = h5::row_range(file.comm(), p.n_owned());
+  for (const FieldBase* f : p.fields()) write_field(file, "/particles/" + f->name(), rows, *f);
+}
+
+void write_histories(h5::ParallelFile& file, const HistoryRecords& h) {
+  file.create_group("/contacts");
+  std::vector<std::int64_t> a(h.size()), b(h.size());
+  std::vector<double> values;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    a[k] = h.a(k);
+    b[k] = h.b(k);
+    values.insert(values.end(), h.values(k), h.values(k) + h.width());
+  }
+  const h5::RowRange rows = h5::row_range(file.comm(), h.size());
+  file.write_attribute("/contacts", "width", static_cast<std::int64_t>(h.width()));
+  file.write_rows("/contacts/a", rows, a.data());
+  file.write_rows("/contacts/b", rows, b.data());
+  if (h.width() > 0) file.write_rows("/contacts/history", rows, values.data(), h.width());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading: every rank opens the file alone, read-only.
+
+class Reader {
+ public:
+  explicit Reader(const std::string& path) : path_(path) {
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+    std::error_code ec;
+    if (!fs::exists(path, ec)) fail("no such file");
+    file_ = h5::FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+    if (!file_.valid()) fail("not an HDF5 file");
+  }
+  [[noreturn]] void fail(const std::string& why) const {
+    throw InputError(path_ + ": error: cannot restart from this checkpoint: " + why);
+  }
+  bool has(const char* name) const { return H5Lexists(file_.get(), name, H5P_DEFAULT) > 0; }
+  // A scalar attribute of the object at `object` (the root by default).
+  template <class T>
+  T attribute(const char* name, hid_t type, const char* object = "/") const {
+    h5::AttributeHandle a(H5Aopen_by_name(file_.get(), object, name, H5P_DEFAULT, H5P_DEFAULT));
+    T value{};
+    if (!a.valid() || H5Aread(a.get(), type, &value) < 0)
+      fail(fmt::format("no attribute {} on {}", name, object));
+    return value;
+  }
+  std::string string_attribute(const char* name) const;
+  std::vector<std::string> strings(const std::string& name) const;
+  // The dataset's rows (its first dimension) and values per row.
+  std::array<hsize_t, 2> shape(const std::string& name) const;
+  // All of the dataset as `type`, into `out` (which is sized to hold it).
+  void read(const std::string& name, hid_t type, void* out) const;
+
+ private:
+  std::string path_;
+  h5::FileHandle file_;
+};
+
+std::string Reader::string_attribute(const char* name) const {
+  h5::AttributeHandle a(H5Aopen_by_name(file_.get(), "/", name, H5P_DEFAULT, H5P_DEFAULT));
+  if (!a.valid()) fail(fmt::format("no attribute {}", name));
+  h5::DatatypeHandle type(H5Aget_type(a.get()));
+  std::string value(H5Tget_size(type.get()), '\0');
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Aread(a.get(), type.get(), value.data()) < 0)
+    fail(fmt::format("attribute {} is not a string", name));
+  return value.substr(0, value.find('\0'));
+}
+
+std::array<hsize_t, 2> Reader::shape(const std::string& name) const {
+  h5::DatasetHandle d(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT));
+  if (!d.valid()) fail("no dataset " + name);
+  h5::DataspaceHandle space(H5Dget_space(d.get()));
+  std::array<hsize_t, 2> dims{0, 1};
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank < 1 || rank > 2 || H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr) < 0)
+    fail("dataset " + name + " has an unexpected shape");
+  return dims;
+}
+
+void Reader::read(const std::string& name, hid_t type, void* out) const {
+  h5::DatasetHandle d(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT));
+  if (!d.valid() || H5Dread(d.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out) < 0)
+    fail("cannot read dataset " + name);
+}
+
+std::vector<std::string> Reader::strings(const std::string& name) const {
+  const hsize_t n = shape(name)[0];
+  h5::DatasetHandle d(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT));
+  h5::DatatypeHandle type(H5Dget_type(d.get()));
+  const std::size_t width = H5Tget_size(type.get());
+  if (H5Tget_class(type.get()) != H5T_STRING || width == 0) fail(name + " is not a string dataset");
+  std::vector<char> buffer(n * width + 1, '\0');
+  if (n > 0) read(name, type.get(), buffer.data());
+  std::vector<std::string> out;
+  for (hsize_t k = 0; k < n; ++k) {
+    const char* s = buffer.data() + k * width;
+    out.emplace_back(s, strnlen(s, width));
+  }
+  return out;
+}
+
+RunState read_state(const Reader& in, int my_rank, int my_size) {
+  RunState s;
+  if (in.string_attribute("format") != kCheckpointFormat)
+    in.fail(fmt::format("its format is not '{}'", kCheckpointFormat));
+  for (const RealAttribute& a : kReals)
+    s.*a.member = in.attribute<double>(a.name, H5T_NATIVE_DOUBLE);
+  for (const CountAttribute& a : kCounts)
+    s.*a.member = in.attribute<std::int64_t>(a.name, H5T_NATIVE_INT64);
+  for (auto [name, value] : count_slots(s))
+    *value = in.attribute<std::int64_t>(name, H5T_NATIVE_INT64);
+  for (auto [name, value] : real_slots(s)) *value = in.attribute<double>(name, H5T_NATIVE_DOUBLE);
+  s.baseline_taken = in.attribute<std::int64_t>("baseline_taken", H5T_NATIVE_INT64) != 0;
+  s.passes.last = static_cast<int>(in.attribute<std::int64_t>("passes_last", H5T_NATIVE_INT64));
+  const auto ranks = static_cast<int>(in.attribute<std::int64_t>("ranks", H5T_NATIVE_INT64));
+  for (auto [name, value] : share_slots(s)) {
+    const std::string path = std::string("/ranks/") + name;
+    if (in.shape(path)[0] != static_cast<hsize_t>(ranks)) in.fail(path + " has the wrong length");
+    std::vector<double> shares(static_cast<std::size_t>(ranks));
+    in.read(path, H5T_NATIVE_DOUBLE, shares.data());
+    // The same rank count: each rank its own share; another: rank 0 the sum, in rank order.
+    double total = 0.0;
+    for (const double x : shares) total += x;
+    *value =
+        ranks == my_size ? shares[static_cast<std::size_t>(my_rank)] : (my_rank == 0 ? total : 0.0);
+  }
+  const std::vector<std::string> kinds = in.strings("/guards/kind");
+  const std::vector<std::string> firsts = in.strings("/guards/first");
+  std::vector<std::int64_t> counts(kinds.size());
+  if (firsts.size() != kinds.size() || in.shape("/guards/count")[0] != kinds.size())
+    in.fail("the /guards datasets differ in length");
+  if (!counts.empty()) in.read("/guards/count", H5T_NATIVE_INT64, counts.data());
+  for (std::size_t k = 0; k < kinds.size(); ++k)
+    s.guards.push_back({kinds[k], counts[k], firsts[k]});
+  return s;
+}
+
+void read_particles(const Reader& in, const Scene& scene, Resumption& r) {
+  ParticleStore layout;  // the fields this scene's particles carry
+  if (scene.breakage.present) layout.enable_damage();
+  r.n_particles = static_cast<std::size_t>(in.shape("/particles/id")[0]);
+  for (const FieldBase* f : layout.fields()) {
+    const std::string name = "/particles/" + f->name();
+    if (!in.has(name.c_str())) in.fail("it holds no particle field '" + f->name() + "'");
+    const std::array<hsize_t, 2> dims = in.shape(name);
+    const std::size_t bytes = r.n_particles * f->bytes_per_item();
+    const std::size_t value_bytes = memory_type(*f) == H5T_NATIVE_INT32 ? 4 : 8;
+    if (dims[0] != r.n_particles || dims[1] * value_bytes != f->bytes_per_item())
+      in.fail("its particle field '" + f->name() + "' has the wrong shape");
+    std::vector<std::byte> column(bytes);
+    if (bytes) in.read(name, memory_type(*f), column.data());
+    r.columns.push_back(std::move(column));
+  }
+}
+
+void read_histories(const Reader& in, Resumption& r) {
+  const auto width =
+      static_cast<std::size_t>(in.attribute<std::int64_t>("width", H5T_NATIVE_INT64, "/contacts"));
+  const auto n = static_cast<std::size_t>(in.shape("/contacts/a")[0]);
+  std::vector<std::int64_t> a(n), b(n);
+  std::vector<double> values(n * width);
+  if (in.shape("/contacts/b")[0] != n ||
+      (width > 0 && (in.shape("/contacts/history")[0] != n ||
+                     (width > 1 && in.shape("/contacts/history")[1] != width))))
+    in.fail("its /contacts datasets differ in length");
+  if (n > 0) {
+    in.read("/contacts/a", H5T_NATIVE_INT64, a.data());
+    in.read("/contacts/b", H5T_NATIVE_INT64, b.data());
+    if (width > 0) in.read("/contacts/history", H5T_NATIVE_DOUBLE, values.data());
+  }
+  r.histories = HistoryRecords(width);
+  for (std::size_t k = 0; k < n; ++k) r.histories.push_back(a[k], b[k], values.data() + k * width);
+}
+
+// The checkpoint's deck against this one: the physics must be the same.
+void check_deck(const Reader& in, const Scene& scene, const std::string& path) {
+  const std::vector<std::string> deck = in.strings("/deck");
+  if (deck.size() != 1) in.fail("it holds no deck");
+  const std::vector<std::string> differ = physics_differences(deck[0], resolved_deck_toml(scene));
+  if (differ.empty()) return;
+  std::string message = fmt::format(
+      "{}: error: --restart {}: the deck's physics differs from the checkpoint's ({} {}); only "
+      "output keys, run.duration, the title and the decomposition keys may change:",
+      scene.deck_path, path, differ.size(), differ.size() == 1 ? "key" : "keys");
+  for (const std::string& d : differ) message += "\n  " + d;
+  throw InputError(message);
+}
+
+Resumption read_all(const std::string& path, const Scene& scene, int rank, int size) {
+  const Reader in(path);
+  Resumption r;
+  r.state = read_state(in, rank, size);
+  check_deck(in, scene, path);
+  read_particles(in, scene, r);
+  read_histories(in, r);
+  return r;
+}
+
+// Flattens a TOML tree into dotted keys (arrays of tables by index: material[1].density) and
+// the printed values.
+void flatten(const toml::node& node, const std::string& key,
+             std::map<std::string, std::string>& out) {
+  if (const toml::table* t = node.as_table()) {
+    for (auto&& [k, v] : *t)
+      flatten(v, key.empty() ? std::string(k.str()) : key + "." + std::string(k.str()), out);
+    return;
+  }
+  const toml::array* a = node.as_array();
+  if (a != nullptr && a->is_array_of_tables()) {
+    for (std::size_t i = 0; i < a->size(); ++i)
+      flatten(*a->get(i), fmt::format("{}[{}]", key, i), out);
+    return;
+  }
+  if (const auto* real = node.as_floating_point()) {
+    out[key] = toml_number(real->get());  // the shortest text that reads back the same
+    return;
+  }
+  std::ostringstream text;
+  node.visit([&text](auto&& v) { text << v; });
+  out[key] = text.str();
+}
+
+// Keys a restart may change: where and how often output goes, how long the run is, its title
+// and how it is spread over ranks.
+bool may_change(const std::string& key) {
+  return key.starts_with("output.") || key == "run.duration" || key == "title" ||
+         key == "run.sectors_per_rank" || key == "run.repartition_threshold";
+}
+
+}  // namespace
+
+std::vector<std::string> physics_differences(const std::string& checkpoint_deck,
+                                             const std::string& deck) {
+  std::map<std::string, std::string> was, now;
+  flatten(toml::parse(checkpoint_deck), "", was);
+  flatten(toml::parse(deck), "", now);
+  std::vector<std::string> out;
+  for (const auto& [key, value] : was) {
+    if (may_change(key)) continue;
+    const auto it = now.find(key);
+    if (it == now.end())
+      out.push_back(fmt::format("{}: checkpoint {}, deck (absent)", key, value));
+    else if (it->second != value)
+      out.push_back(fmt::format("{}: checkpoint {}, deck {}", key, value, it->second));
+  }
+  for (const auto& [key, value] : now)
+    if (!may_change(key) && !was.contains(key))
+      out.push_back(fmt::format("{}: checkpoint (absent), deck {}", key, value));
+  return out;
+}
+
+Resumption read_checkpoint(MPI_Comm comm, const std::string& path, const Scene& scene) {
+  std::string error;
+  Resumption r;
+  try {
+    r = read_all(path, scene, mpi::rank(comm), mpi::size(comm));
+  } catch (const InputError& e) {
+    for (const std::string& m : e.messages()) error += (error.empty() ? "" : "\n") + m;
+  } catch (const toml::parse_error& e) {
+    error = path + ": error: cannot restart from this checkpoint: its deck does not parse";
+  }
+  mpi::agree_on_failure<InputError>(comm, error);
+  return r;
+}
+
+void write_checkpoint(MPI_Comm comm, const std::string& path, const Simulation& sim) {
+  const std::string temporary = path + ".tmp";
+  const ParticleStore& p = sim.particles();
+  const HistoryRecords histories = sim.histories();
+  const std::uint64_t bytes =
+      mpi::sum(comm, static_cast<std::uint64_t>(p.n_owned() * p.bytes_per_particle() +
+                                                histories.size() * histories.record_bytes())) +
+      2048 * (p.fields().size() + 16) + 16384;
+  ensure_free_space(comm, temporary, bytes);
+  std::string error;
+  try {
+    h5::ParallelFile file = h5::ParallelFile::create(comm, temporary);
+    write_state(file, sim, mpi::size(comm));
+    write_particles(file, sim.particles());
+    write_histories(file, histories);
+    file.close();
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  mpi::agree_on_failure<IoError>(comm, error);
+  if (mpi::rank(comm) == 0) {
+    std::error_code ec;
+    fs::rename(temporary, path, ec);
+    if (ec) {
+      error = fmt::format("cannot write {}: {}", path, ec.message());
+      fs::remove(temporary, ec);
+    }
+  }
+  mpi::agree_on_failure<IoError>(comm, error);
+}
+
+}  // namespace dem2d
