@@ -151,17 +151,6 @@ class Progress {
   Clock::time_point start_, last_;
 };
 
-// The angular-sector decomposition about the drum centre (the particles' centre without a
-// drum); on one rank its verbs are trivial.
-DecompositionOptions decomposition_of(const Scene& scene) {
-  DecompositionOptions d;
-  d.has_center = scene.drum.present;
-  d.center = scene.drum.center;
-  d.sectors_per_rank = scene.run.sectors_per_rank;
-  d.repartition_threshold = scene.run.repartition_threshold;
-  return d;
-}
-
 // Collective. An output directory that cannot be written is bad input (exit 2), named by its
 // key; a write that fails later (disk full) stays an I/O failure (exit 4).
 // One folder, one run: the output directory is created, checked and locked for this run (a

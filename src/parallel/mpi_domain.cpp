@@ -10,6 +10,15 @@
 
 namespace dem2d {
 
+DecompositionOptions decomposition_of(const Scene& scene) {
+  DecompositionOptions d;
+  d.has_center = scene.drum.present;
+  d.center = scene.drum.center;
+  d.sectors_per_rank = scene.run.sectors_per_rank;
+  d.repartition_threshold = scene.run.repartition_threshold;
+  return d;
+}
+
 namespace {
 
 // Wall-clock accumulator for the time spent communicating.

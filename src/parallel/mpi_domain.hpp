@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "core/domain.hpp"
+#include "core/scene.hpp"
 #include "core/vec2.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/sector_partition.hpp"
@@ -68,6 +69,10 @@ struct DecompositionOptions {
   double repartition_threshold = 1.05;  // max/mean work that triggers a repartition
   int repartition_gap = 10;             // rebuilds between two partitions at least
 };
+
+// The decomposition a scene asks for: sectors about the drum centre (the particles' centre
+// without a drum), with the deck's sectors per rank and repartition threshold.
+DecompositionOptions decomposition_of(const Scene& scene);
 
 // What the decomposition did, for run.json and bench/strong_scaling.
 struct DecompositionStats {
