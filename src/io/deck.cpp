@@ -939,13 +939,17 @@ class DeckParser {
       const auto shear = accepted.get<double>("shear_modulus");
       if (!shear || !youngs) return;
       const double nu = *youngs / (2.0 * *shear) - 1.0;
-      if (nu >= -1.0 && nu < 0.5) {
+      // The range of the poisson_ratio key, so that the resolved deck, which may write the
+      // ratio instead, reads back (a shear modulus above E/2 was accepted and its resolved
+      // deck refused: found by the fuzzer).
+      if (nu >= 0.0 && nu < 0.5) {
         m.poisson_ratio = nu;
       } else {
         r.invalid("shear_modulus",
                   fmt::format("gives poisson_ratio = youngs_modulus / (2 shear_modulus) - 1 "
-                              "= {:.6g}, which must be in [-1, 0.5) (shear_modulus > {:.6g})",
-                              nu, *youngs / 3.0));
+                              "= {:.6g}, which must be in [0, 0.5) ({:.6g} < shear_modulus "
+                              "<= {:.6g})",
+                              nu, *youngs / 3.0, *youngs / 2.0));
       }
     } else if (youngs) {
       m.shear_modulus = *youngs / (2.0 * (1.0 + m.poisson_ratio));

@@ -83,6 +83,19 @@ then pass "run.json names the checkpoint it continued"; else fail "run.json lack
 on 1 "${wf[@]}" --output "$tmp/wf_every" --set output.checkpoint_interval=0.05
 same_particles "checkpoints every 0.05 s change nothing" "$tmp/wf_ref" "$tmp/wf_every"
 
+# Checkpoints by the wall clock (output.checkpoint_minutes, here every 0.3 s of wall time): a
+# run killed 2 s into its 10 simulated seconds (4 s or more of wall time) has one from on the way.
+"$dem2d" "$src/inputs/waterfall.in" --quiet --set run.duration=10 --set output.checkpoint_minutes=0.005 \
+  --output "$tmp/wf_minutes" &
+pid=$!
+sleep 2
+kill -9 "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+t_ck=$("$py" -c "import h5py, sys; print(h5py.File(sys.argv[1], 'r').attrs['time'])" "$tmp/wf_minutes/checkpoint.h5" 2>/dev/null)
+if [ -n "$t_ck" ] && "$py" -c "import sys; t = float(sys.argv[1]); sys.exit(not 0 < t < 10)" "$t_ck"; then
+  pass "checkpoint_minutes: a checkpoint on the way (t = $t_ck s)"
+else fail "checkpoint_minutes: no checkpoint on the way (${t_ck:-none})"; fi
+
 # --- The iterative integrator: the drop deck, 0.1 s stopped at 0.05 s --------------------------
 it=("$src/inputs/drop.in" --quiet --set run.integrator=iterative --set run.duration=0.1 --set output.snapshot_interval=0.01)
 on 1 "${it[@]}" --output "$tmp/it_ref"

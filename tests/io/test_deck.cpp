@@ -681,8 +681,8 @@ position = [0.0, 0.0]
   EXPECT_TRUE(has_message(messages,
                           "deck.in:13:17: error: material[1].shear_modulus = 1.0e8: "
                           "gives poisson_ratio = youngs_modulus / (2 shear_modulus) - "
-                          "1 = 4, which must be in [-1, 0.5) (shear_modulus > "
-                          "3.33333e+08)"));
+                          "1 = 4, which must be in [0, 0.5) (3.33333e+08 < "
+                          "shear_modulus <= 5e+08)"));
   EXPECT_TRUE(has_message(messages,
                           "deck.in:16:8: error: material[2].name = \"a\": already the "
                           "name of material[0]"));
