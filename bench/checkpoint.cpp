@@ -18,7 +18,7 @@
 //  - settled (--packing settled): the settled packings of bench/throughput (cached in
 //    DIR/cache/settled_drum_<N>.csv; settled first if absent: 1 s at 1e3, 33 s at 1e4, 15 min
 //    at 1e5), S steps with the drum turning: a cross-check of the file size.
-//  - waterfall: inputs/waterfall.in (240 balls) run to T simulated seconds (default 1), its
+//  - waterfall: inputs/waterfall_polygon.in (240 balls) run to T simulated seconds (default 1), its
 //    step time from 2000 steps.
 // The lattice and settled particles enter the scene as a deck's `[[fill]] file = "..."` packing
 // does (the resolved deck in the checkpoint names the file); --explicit-particles makes them
@@ -394,7 +394,7 @@ std::vector<Row> run_all(const Args& a, MPI_Comm comm) {
     if (root) print_row(rows.back());
   }
   if (a.waterfall) {
-    const Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall.in");
+    const Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall_polygon.in");
     rows.push_back(measure(a, "waterfall", s, a.waterfall_time, 2000, comm));
     if (root) print_row(rows.back());
   }

@@ -10,7 +10,7 @@
 //                   compiled into the kernel the scene runs);
 //   charge only     the same charge without [breakage], [feed] and [sieve] (the kernel and the
 //                   step of a scene without ore models);
-//   waterfall       inputs/waterfall.in, the thesis scene with no ore models.
+//   waterfall       inputs/waterfall_polygon.in, the thesis scene with no ore models.
 // Each row: particle-steps per wall second over the steps (the steps only), the particles at
 // the end, breakages, fed and discharged counts, and the two error measures: the mass balance
 // (initial mill mass + fed - mill mass - discharged, over the mill mass, worst row) and the
@@ -93,7 +93,7 @@ double timed(const std::string& command) {
 
 // The waterfall by the old and the new binary, alternately; returns the median new/old ratio.
 double baseline_ratio(const std::string& old_binary, int pairs, const std::string& results) {
-  const std::string deck = DEM2D_SOURCE_DIR "/inputs/waterfall.in";
+  const std::string deck = DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in";
   const std::string args = " --quiet " + deck + " --set run.duration=3 --output ";
   const std::string new_binary = DEM2D_BINARY;
   std::vector<double> ratios;
@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
   Scene charge = no_breakage;
   charge.feed.present = false;
   charge.sieve.present = false;
-  Scene waterfall = load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall.in");
+  Scene waterfall = load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in");
   std::vector<Row> rows;
   std::printf("%-13s %12s %9s %9s %5s %10s %12s %12s\n", "scene", "p-steps/s", "particles",
               "breakages", "fed", "discharged", "mass_error", "energy_res");

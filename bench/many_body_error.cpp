@@ -3,8 +3,8 @@
 // compare time averages that lie inside the chaotic spread between seeds).
 //
 // Two scenes, each from its initial fill (8 seeds, 8 fills; 3 with --quick):
-//   waterfall   inputs/waterfall.in (240 balls, r = 0.1 m, 16-gon drum, 1.8 rad/s after 0.5 s);
-//   polydisperse the same drum and speed with 240 balls of radius 0.05-0.1 m.
+//   waterfall   inputs/waterfall_polygon.in (240 balls, r = 0.1 m, 16-gon drum, 1.8 rad/s after 0.5
+//   s); polydisperse the same drum and speed with 240 balls of radius 0.05-0.1 m.
 // For each integrator and dt = dt_auto x {1/4, 1/2, 1} (on one time grid, so that the runs are
 // compared at the same instant):
 //   trajectory  the RMS distance, over the particles matched by id, between this run and a
@@ -61,7 +61,7 @@ double g_dt_auto = 0.0;
 constexpr double kLedgerTime = 1.0;
 
 Scene scene_of(const std::string& name) {
-  Scene s = load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall.in");
+  Scene s = load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in");
   if (name == "polydisperse") {
     s.fills[0].radius_min = 0.05;
     s.fills[0].radius_max = 0.1;

@@ -13,7 +13,7 @@
 //  - drum30k: the 30 000-sphere settled charge of bench/throughput (bench/settled_drum.hpp, read
 //    from DIR/cache/settled_drum_30000.csv: run build/bench/throughput --particles 30000 once),
 //    drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps (default 2000).
-//  - waterfall: inputs/waterfall.in (240 balls), T simulated seconds (default 1).
+//  - waterfall: inputs/waterfall_polygon.in (240 balls), T simulated seconds (default 1).
 // Each timed segment runs R times in a row (--repeats, default 3); the fastest counts.
 // Columns: wall (max over ranks of the timed loop), speedup and efficiency, imbalance (max/mean of
 // the ranks' work = owned particles + listed pairs, averaged over the rebuilds), ghosts per owned
@@ -132,7 +132,7 @@ int worker(const Args& a) {
                              MPI_COMM_WORLD));
   }
   {
-    Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall.in");
+    Scene s = load_deck(std::string(DEM2D_SOURCE_DIR) + "/inputs/waterfall_polygon.in");
     rows.push_back(measure("waterfall", s, 0,
                            static_cast<std::int64_t>(a.waterfall_time / s.run.dt + 0.5), a.repeats,
                            MPI_COMM_WORLD));

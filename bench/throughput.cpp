@@ -11,7 +11,8 @@
 //     drum radius R = 2.5 m sqrt(N / 30 000) so that the fill fraction stays 0.31, and drum
 //     speed 1.5 rad/s sqrt(2.5 m / R) so that the Froude number stays 0.57; N = 3e4 is case (a).
 //     Steps per size: max(--steps, 3e7 / N), so each size runs at least ~3e7 particle-steps.
-// (c) The waterfall deck (inputs/waterfall.in, 240 balls, 10 s at dt = 1e-5 s) run through the
+// (c) The waterfall deck (inputs/waterfall_polygon.in, 240 balls, 10 s at dt = 1e-5 s) run through
+// the
 //     Simulation API without output, against the target of 5 s.
 //
 // Settling (not timed) is described in bench/settled_drum.hpp: a soft settle with the drum
@@ -134,7 +135,7 @@ Row measure_drum(const Options& opt, std::int64_t n) {
 Row measure_waterfall(double duration) {
   Row row;
   row.section = "waterfall";
-  Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall.in");
+  Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in");
   s.run.duration = duration;
   const Stopwatch build;
   Simulation sim(s);

@@ -16,7 +16,7 @@
 //     time of the step loops (from the reset just before touch until the balls separate)
 //     divided by the repeats. The peak overlap is refined by a parabola through the largest
 //     sample and its two neighbours (the raw largest sample is in the CSV too).
-// (b) The waterfall scene (inputs/waterfall.in: 240 balls, 16-gon drum at 1.8 rad/s after a
+// (b) The waterfall scene (inputs/waterfall_polygon.in: 240 balls, 16-gon drum at 1.8 rad/s after a
 //     0.5 s ramp), shortened to --duration seconds (default 2.0); time averages over
 //     [--window-start (default 0.5), duration]: drum power = (drive work at the end - at the
 //     start) / window (exact: the drive work is accumulated every step) and translational
@@ -454,7 +454,7 @@ WaterfallRun run_waterfall(const Options& opt, const IntegratorCase& ic, double 
   out.dt = dt;
   out.seed = seed;
   try {
-    Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall.in");
+    Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in");
     s.run.duration = opt.duration;
     s.run.seed = seed;
     apply_integrator(s, ic, dt);
@@ -517,7 +517,8 @@ std::vector<WaterfallRun> waterfall_study(const Options& opt) {
   const double dt_min = opt.quick ? 4.0e-6 : 1.0e-6;
   const double dt_ref = opt.quick ? 1.0e-6 : 1.0e-5 / 16.0;
   std::printf(
-      "\n== (b) waterfall scene (inputs/waterfall.in) shortened to %.2f s; averages over [%.2f, "
+      "\n== (b) waterfall scene (inputs/waterfall_polygon.in) shortened to %.2f s; averages over "
+      "[%.2f, "
       "%.2f] s\n",
       opt.duration, opt.window_start, opt.duration);
   std::printf(
@@ -705,7 +706,7 @@ Spread summarize_waterfall(const std::vector<WaterfallRun>& runs) {
 // The verdict: the waterfall's time averages only show where a dt goes unstable; the accuracy
 // limit comes from the impact test, applied to the scene's fastest expected impact.
 void recommend(const std::vector<ImpactBest>& impact, const std::vector<WaterfallRun>& runs) {
-  Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall.in");
+  Scene s = dem2d::load_deck(DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in");
   const Simulation probe(s);
   const double tc = probe.scales().hertz;
   std::printf("\n== recommended default\n");

@@ -24,6 +24,7 @@
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
 #include "io/checkpoint.hpp"
+#include "io/collisions.hpp"
 #include "io/deck.hpp"
 #include "io/ore_logs.hpp"
 #include "io/output_dir.hpp"
@@ -64,6 +65,25 @@ std::string fmt_double(const char* format, double x) {
   return buf;
 }
 
+// The mill's numbers (--check).
+std::string mill_check_lines(const Scene& s, const MillNumbers& m) {
+  std::string out =
+      fmt_double("  fill fraction:         %.4f (particle cross-sections / drum area)\n",
+                 m.fill_fraction) +
+      fmt_double("  bed filling J:         %.3f", m.bed_filling) +
+      fmt_double(" (the bed with its voids / drum area, packing %.2f)\n", kBedPacking);
+  out += fmt_double("  critical speed:        %.4f rad/s", m.critical_speed) +
+         fmt_double(" = sqrt(g/R) (%.2f rpm);", m.critical_speed * 30.0 / std::numbers::pi) +
+         fmt_double(" with fill (thesis T37) %.4f rad/s\n", m.critical_speed_with_fill);
+  out += fmt_double("  drum speed:            %.4f rad/s", s.drum.speed) +
+         fmt_double(" = %.3f of critical", m.speed_fraction) +
+         fmt_double(" (Froude number %.4f)\n", m.froude);
+  out += fmt_double("  2D to 3D:              the slice is %.4g m thick", m.slice_thickness) +
+         " (the largest ball's diameter); a mill L m long draws about L / " +
+         fmt_double("%.4g times its power\n", m.slice_thickness);
+  return out;
+}
+
 // Derived quantities of a scene (--check).
 void print_check(const Simulation& sim) {
   const Scene& s = sim.scene();
@@ -72,23 +92,12 @@ void print_check(const Simulation& sim) {
   std::string out = "dem2d --check " + s.deck_path + ": the deck is valid\n";
   if (!s.title.empty()) out += "  title:                 " + s.title + "\n";
   out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
-  double area = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k)
+  double area = 0.0, r_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
     area += std::numbers::pi * p.radius[k] * p.radius[k];
-  const double g = norm(s.run.gravity);
-  if (s.drum.present) {
-    const double R = s.drum.radius;
-    const double phi = area / (std::numbers::pi * R * R);
-    const double w_classic = std::sqrt(g / R);
-    const double w_thesis = std::pow(1.0 - std::min(phi, 0.99), -0.25) * w_classic;  // T37
-    out += fmt_double("  fill fraction:         %.4f (particle cross-sections / drum area)\n", phi);
-    out += fmt_double("  critical speed:        %.4f rad/s", w_classic) +
-           fmt_double(" = sqrt(g/R) (%.2f rpm);", w_classic * 30.0 / std::numbers::pi) +
-           fmt_double(" with fill (thesis T37) %.4f rad/s\n", w_thesis);
-    out += fmt_double("  drum speed:            %.4f rad/s", s.drum.speed) +
-           fmt_double(" = %.3f of critical", s.drum.speed / w_classic) +
-           fmt_double(" (Froude number %.4f)\n", s.drum.speed * s.drum.speed * R / g);
+    r_max = std::max(r_max, p.radius[k]);
   }
+  if (s.drum.present) out += mill_check_lines(s, mill_numbers(s, area, r_max));
   out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
@@ -183,7 +192,7 @@ class SeriesOutput {
       file_ = std::make_unique<SeriesWriter>(scene.output.directory + "/" + kSeriesFile,
                                              scene.run.integrator == IntegratorKind::kIterative,
                                              g_rank == 0, is_ore_scene(scene),
-                                             resumed ? sim.step_count() : -1);
+                                             resumed ? sim.step_count() : -1, scene.drum.present);
     } catch (const IoError& e) {
       error = e.what();
     }
@@ -308,8 +317,9 @@ class RunLoop {
     return std::abs(t - k * interval) < 0.5 * sim_.dt();
   }
   void snapshot() {
-    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), wall_outlines(sim_.walls()));
     last_snapshot_time_ = sim_.time();
+    if (sim_.spectra()) write_collisions(MPI_COMM_WORLD, scene_.output.directory, *sim_.spectra());
   }
   void after_step();
   // The logs' records up to now first: a restart keeps the rows up to the checkpoint's time.
@@ -340,7 +350,7 @@ class RunLoop {
 Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
   const OutputSpec& out = scene_.output;
   if (!resumed_) {
-    series_.write(sim_.diagnostics());
+    series_.write(sim_.record_row());
     sim_.reset_pass_window();
     if (out.snapshot_interval > 0) snapshot();
   }
@@ -354,7 +364,7 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
     }
   } catch (const UnstableError& e) {
     ore_.write(sim_);
-    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count());
+    snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), wall_outlines(sim_.walls()));
     say(scene_.deck_path + ": error: " + e.what() + "; last snapshot written to " + out.directory +
             "/" + kSnapshotsFile + "\n",
         stderr);
@@ -371,7 +381,7 @@ void RunLoop::after_step() {
             " (run.guards = \"warn\": the run goes on)\n",
         stderr);
   if (at_multiple(sim_.time(), out.series_interval)) {
-    series_.write(sim_.diagnostics());
+    series_.write(sim_.record_row());
     ore_.write(sim_);
     sim_.reset_pass_window();
   }
@@ -398,9 +408,46 @@ Ending RunLoop::finish(Ending ending) {
   const OutputSpec& out = scene_.output;
   if (last_snapshot_time_ != sim_.time()) snapshot();
   if (ending == Ending::kFinished && !at_multiple(sim_.time(), out.series_interval))
-    series_.write(sim_.diagnostics());
+    series_.write(sim_.record_row());
   if (checkpoint_step_ != sim_.step_count()) checkpoint();
   return ending;
+}
+
+// Collective: run.json's "mill" object: the mill's numbers, and the averages and regime over
+// the last analysis window.
+std::string mill_json(const Simulation& sim, const MpiDomain& domain) {
+  const ParticleStore& p = sim.particles();
+  double area = 0.0, r_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    area += std::numbers::pi * p.radius[k] * p.radius[k];
+    r_max = std::max(r_max, p.radius[k]);
+  }
+  const MillNumbers m = mill_numbers(sim.scene(), domain.sum(area), domain.max(r_max));
+  const WindowSummary w = sim.mill_summary();
+  const auto number = [](double x) { return std::isfinite(x) ? fmt_double("%.10g", x) : "null"; };
+  const std::pair<const char*, double> items[] = {
+      {"critical_speed_rad_s", m.critical_speed},
+      {"critical_speed_rpm", m.critical_speed * 30.0 / std::numbers::pi},
+      {"critical_speed_with_fill_rad_s", m.critical_speed_with_fill},
+      {"speed_fraction_of_critical", m.speed_fraction},
+      {"froude_number", m.froude},
+      {"fill_fraction", m.fill_fraction},
+      {"bed_filling", m.bed_filling},
+      {"bed_packing", kBedPacking},
+      {"slice_thickness_m", m.slice_thickness},
+      {"window_s", w.span},
+      {"power_avg_W", w.power},
+      {"power_per_metre_W", m.slice_thickness > 0 ? w.power / m.slice_thickness : 0.0},
+      {"airborne_fraction", w.airborne},
+      {"corotating_fraction", w.corotating},
+      {"toe_angle_deg", w.toe},
+      {"shoulder_angle_deg", w.shoulder},
+      {"surface_angle_deg", w.surface_angle},
+      {"charge_angle_deg", w.charge_angle},
+      {"charge_angle_std_deg", w.charge_angle_std}};
+  std::string out = "{\"regime\": \"" + std::string(regime_name(w.regime)) + "\"";
+  for (const auto& [key, value] : items) out += ", \"" + std::string(key) + "\": " + number(value);
+  return out + "}";
 }
 
 // Collective (the decomposition's per-rank figures are gathered): what run.json records.
@@ -444,6 +491,7 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   info.extra.emplace_back("partitions", std::to_string(ds.partitions));
   info.extra.emplace_back("partition_method", "\"" + ds.method + "\"");
   info.extra.emplace_back("sectors", std::to_string(domain.partition().n_sectors));
+  if (scene.drum.present) info.extra.emplace_back("mill", mill_json(sim, domain));
   return info;
 }
 
@@ -555,17 +603,37 @@ int main(int argc, char** argv) {
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
   install_stop_handlers();
 
-  CLI::App app{"dem2d: 2D discrete element simulator of tumbling ball mills"};
+  CLI::App app{"dem2d: 2D discrete element simulator of tumbling ball mills", "dem2d"};
+  // The usage line names every option in the order given below (CLI11 prints "[OPTIONS]").
+  struct UsageFormatter : CLI::Formatter {
+    std::string make_usage(const CLI::App* a, std::string name) const override {
+      std::string out = "Usage: " + name, positionals;
+      for (const CLI::Option* o : a->get_options()) {
+        std::string arg = o->get_type_name().empty() ? "" : " " + o->get_type_name();
+        if (o->get_expected_max() > 1) arg += " ...";
+        if (o->get_positional()) {
+          positionals += " " + o->get_name();
+        } else if (!o->get_name().empty()) {  // not hidden
+          out += " [" + o->get_name() + arg + "]";
+        }
+      }
+      return out + positionals + "\n";
+    }
+  };
+  app.formatter(std::make_shared<UsageFormatter>());
   Options opt;
   app.add_option("INPUT", opt.deck, "input deck (.in, TOML)");
   app.add_flag("--check", opt.check, "validate the deck, print derived quantities, run nothing");
   // One KEY=VALUE per --set (repeatable), so that --set may stand before the deck too.
   app.add_option("--set", opt.sets, "override a deck key: --set drum.speed=1.5 (repeatable)")
-      ->allow_extra_args(false);
-  app.add_option("--output", opt.output, "output directory (overrides output.directory)");
+      ->allow_extra_args(false)
+      ->type_name("KEY=VALUE");
+  app.add_option("--output", opt.output, "output directory (overrides output.directory)")
+      ->type_name("DIR");
   app.add_option("--restart", opt.restart,
                  "continue the run from a checkpoint (DIR/checkpoint.h5) to the deck's "
-                 "run.duration, on any rank count, appending to the output in the deck's folder");
+                 "run.duration, on any rank count, appending to the output in the deck's folder")
+      ->type_name("FILE");
   app.add_flag("--quiet", opt.quiet, "no progress line");
   app.add_flag("--overwrite", opt.overwrite,
                "replace the output of an earlier run in the output directory (never a running "

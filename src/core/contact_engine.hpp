@@ -36,6 +36,7 @@ struct EvaluationTotals {
   double dissipated = 0.0;                  // J in this step
   double elastic = 0.0;                     // J stored in all contacts
   double drum_torque = 0.0;                 // N m applied by the drive
+  double lifter_torque = 0.0;               // N m of it through the lifters
   double drive_power = 0.0;                 // W delivered by moving walls
   double max_overlap = 0.0;                 // largest delta / min(r_i, r_j)
   std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)

@@ -522,8 +522,11 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
       wl.trial[static_cast<std::size_t>(k) * W + s] = wb_.history.fresh[s][c];
     // Power the wall's drive puts into the particles: F . v_wall + M Omega (the reaction couple).
     tot.drive_power += dot(fi, Vec2{wb_.wx[c], wb_.wy[c]}) + m_roll * bodies[e.body].omega;
-    if (e.body == drum)
-      tot.drum_torque += cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
+    if (e.body == drum) {
+      const double torque = cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
+      tot.drum_torque += torque;
+      if (e.part == WallPart::kLifter) tot.lifter_torque += torque;
+    }
     const double ratio = wb_.delta[c] / wb_.r[c];
     if (ratio > max_ratio) {
       max_ratio = ratio;

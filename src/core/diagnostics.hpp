@@ -21,7 +21,18 @@ struct SeriesRow {
   double drum_torque = 0.0;        // torque the drive applies to keep the drum's speed
   double drum_power = 0.0;         // drum_torque * drum speed
   double drive_work = 0.0;         // cumulative work done by the drive (and moving walls)
-  double passes = 0.0;             // iterative integrator: mean passes per step since last row
+  // Drum scenes (core/mill_analytics.hpp): the drive's torque and power through the shell and
+  // through the lifters (drum_torque = shell_torque + lifter_torque), the power averaged over
+  // the analysis window, the charge's shape and the regime over the window.
+  double shell_torque = 0.0, lifter_torque = 0.0;  // N m
+  double shell_power = 0.0, lifter_power = 0.0;    // W
+  double drum_work = 0.0;                          // J, cumulative work of the drum's drive
+  double power_avg = 0.0;                          // W, drum_work over the window / its length
+  double toe_angle = 0.0, shoulder_angle = 0.0, surface_angle = 0.0, shell_arc = 0.0;  // deg
+  double com_x = 0.0, com_y = 0.0;  // m from the drum centre
+  double airborne_fraction = 0.0, corotating_fraction = 0.0;
+  const char* regime = "-";
+  double passes = 0.0;  // iterative integrator: mean passes per step since last row
   // Ore scenes ([breakage], [feed], [sieve]): counts and masses since the start.
   std::int64_t breakages = 0, fragments = 0, fed_count = 0, discharged_count = 0;
   double fed_mass = 0.0, discharged_mass = 0.0;  // kg

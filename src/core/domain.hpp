@@ -43,6 +43,10 @@ class Domain {
   virtual bool any(bool x) const { return x; }
   // Element-wise maximum over ranks, in place (several decisions in one reduction).
   virtual void max(std::span<double> /*values*/) const {}
+  // Element-wise sums over ranks, in place (diagnostics: histograms, moments). Counts are
+  // exact; doubles may differ in the last bits between rank counts.
+  virtual void sum(std::span<std::int64_t> /*values*/) const {}
+  virtual void sum(std::span<double> /*values*/) const {}
   // Every rank's values, rank 0's first (population changes: the parents broken in a step).
   virtual std::vector<std::int64_t> allgather(std::span<const std::int64_t> mine) const {
     return {mine.begin(), mine.end()};

@@ -23,6 +23,14 @@ void ParticleStore::enable_damage() {
   damage_->resize(size());
 }
 
+void ParticleStore::enable_last_contact() {
+  if (last_contact_) return;
+  last_contact_ = std::make_unique<Field<double>>(
+      "last_contact", registry_,
+      FieldMeta{"s", "time the particle last touched anything, seen at the series rows"});
+  last_contact_->resize(size());
+}
+
 void ParticleStore::resize_all(std::size_t n) {
   for (FieldBase* f : registry_) f->resize(n);
 }

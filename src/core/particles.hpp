@@ -144,6 +144,11 @@ class ParticleStore {
   Field<double>* damage() { return damage_.get(); }
   const Field<double>* damage() const { return damage_.get(); }
   void enable_damage();
+  // Drum scenes (mill analytics): the time each particle last touched anything, as seen at the
+  // series rows; a particle untouched for kFlightTime is in free flight.
+  Field<double>* last_contact() { return last_contact_.get(); }
+  const Field<double>* last_contact() const { return last_contact_.get(); }
+  void enable_last_contact();
 
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }
@@ -173,6 +178,7 @@ class ParticleStore {
   void resize_all(std::size_t n);
   std::size_t n_owned_ = 0;
   std::unique_ptr<Field<double>> damage_;
+  std::unique_ptr<Field<double>> last_contact_;
 };
 
 }  // namespace dem2d

@@ -21,6 +21,7 @@
 
 #include "core/grinding.hpp"
 #include "core/integrators.hpp"
+#include "core/mill_analytics.hpp"
 
 namespace dem2d {
 
@@ -46,6 +47,12 @@ struct RunState {
   std::int64_t neighbor_builds = 0;
   std::vector<GuardRecord> guards;
   GrindingState grinding;  // ore scenes only
+  // Mill analytics: this rank's share of the drum's drive work, the analysis window's samples
+  // (global), and the collision spectra summed over ranks (a resumed run gives them to rank 0).
+  double rank_drum_work = 0.0;
+  std::vector<MillSample> mill_samples;
+  std::vector<std::int64_t> spectra_counts;
+  std::vector<double> spectra_energies;
 };
 
 }  // namespace dem2d

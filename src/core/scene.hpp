@@ -178,6 +178,12 @@ struct OutputSpec {
   double checkpoint_interval = 0.0;  // s of simulated time; 0: none (but at the end)
   double checkpoint_minutes = 0.0;   // min of wall-clock time; 0: none
   double progress_interval = 5.0;    // s of wall time between plain progress lines
+  // Mill analytics (core/mill_analytics.hpp): the averaging window of power and regime, and the
+  // collision energy spectra with their size classes (edges size_class_min * ratio^k, m).
+  double analysis_window = 1.0;
+  bool collision_spectra = false;
+  double size_class_min = 0.001;
+  double size_class_ratio = 2.0;
 };
 
 struct Scene {
@@ -210,6 +216,15 @@ struct Scene {
 // A scene with ore models ([breakage], [feed] or [sieve]).
 inline bool is_ore_scene(const Scene& s) {
   return s.breakage.present || s.feed.present || s.sieve.present;
+}
+
+// The contact models a scene runs: its [contact] with the trackers its tables ask for switched
+// on (breakage, which records the peak energy too; else the collision spectra's peak energy).
+inline ContactSpec active_contact(const Scene& s) {
+  ContactSpec c = s.contact;
+  c.track_breakage = s.breakage.present;
+  c.track_peak_energy = s.contact.track_peak_energy || s.output.collision_spectra;
+  return c;
 }
 
 // Index of a material by name, or -1.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -15,7 +16,7 @@ namespace {
 // The scene as the core runs it: the models a table asks for switched on.
 Scene prepared(const Scene& scene) {
   Scene s = scene;
-  s.contact.track_breakage = scene.breakage.present;
+  s.contact = active_contact(scene);
   return s;
 }
 
@@ -34,6 +35,7 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
       walls_(scene_),
       contacts_(scene_) {
   if (scene_.breakage.present) particles_.enable_damage();
+  if (scene_.drum.present) particles_.enable_last_contact();
   if (resume)
     load_particles(*resume);
   else
@@ -58,6 +60,29 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
   if (scene_.breakage.present || scene_.feed.present || scene_.sieve.present)
     grinding_ = std::make_unique<Grinding>(scene_, particles_, *domain_);
   if (resume && grinding_) grinding_->restore(resume->state.grinding);
+  set_up_analytics(resume);
+}
+
+// The analysis window and the collision spectra (output.collision_spectra), continued from a
+// checkpoint's: its sums go to rank 0.
+void Simulation::set_up_analytics(const Resumption* resume) {
+  mill_window_ = MillWindow(scene_.output.analysis_window);
+  if (resume) {
+    drum_work_ = resume->state.rank_drum_work;
+    mill_window_.restore(resume->state.mill_samples);
+  }
+  if (!scene_.output.collision_spectra) return;
+  std::vector<double> edges;
+  for (double d = scene_.output.size_class_min; d < 10.0; d *= scene_.output.size_class_ratio)
+    edges.push_back(d);
+  std::vector<bool> ore(scene_.materials.size(), false);
+  if (grinding_) ore[static_cast<std::size_t>(grinding_->ore_material())] = true;
+  spectra_ = std::make_unique<CollisionSpectra>(std::move(edges), std::move(ore));
+  if (resume && domain_->rank() == 0 &&
+      resume->state.spectra_counts.size() == spectra_->counts().size()) {
+    spectra_->counts() = resume->state.spectra_counts;
+    spectra_->energies() = resume->state.spectra_energies;
+  }
 }
 
 // The skin and the halo, then every rank keeps its own particles (every rank placed or loaded
@@ -156,6 +181,12 @@ RunState Simulation::run_state() const {
   s.neighbor_builds = neighbor_builds();
   s.guards = guards_;
   if (grinding_) s.grinding = grinding_->state();
+  s.rank_drum_work = drum_work_;
+  s.mill_samples = mill_window_.samples();
+  if (spectra_) {
+    s.spectra_counts = spectra_->counts();
+    s.spectra_energies = spectra_->energies();
+  }
   return s;
 }
 
@@ -309,10 +340,20 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
 }
 
 void Simulation::commit(double dt, double late_loss) {
+  if (spectra_) {
+    const PairList& pl = contacts_.pairs();
+    const WallPairList& wl = contacts_.wall_pairs();
+    spectra_->book_ended(particles_, walls_, pl.history.data(), pl.trial.data(),
+                         {pl.i.data(), pl.size()}, {pl.j.data(), pl.size()}, wl.history.data(),
+                         wl.trial.data(), {wl.particle.data(), wl.size()},
+                         {wl.element.data(), wl.size()}, pl.width,
+                         contacts_.history_offset("peak_energy"));
+  }
   contacts_.commit();
   const EvaluationTotals& t = contacts_.totals();
   dissipated_ += t.dissipated + late_loss;
   drive_work_ += t.drive_power * dt;
+  drum_work_ += t.drum_torque * walls_.drum_omega() * dt;
 }
 
 void Simulation::refresh_forces() {
@@ -445,8 +486,37 @@ SeriesRow Simulation::diagnostics() const {
   row.drum_torque = domain_->sum(totals.drum_torque);
   row.drum_power = row.drum_torque * walls_.drum_omega();
   row.drive_work = domain_->sum(drive_work_);
+  row.lifter_torque = domain_->sum(totals.lifter_torque);
+  row.shell_torque = row.drum_torque - row.lifter_torque;
+  row.shell_power = row.shell_torque * walls_.drum_omega();
+  row.lifter_power = row.lifter_torque * walls_.drum_omega();
+  row.drum_work = domain_->sum(drum_work_);
   row.passes = integrator_->passes().mean_since_row();
   if (grinding_) grinding_row(row);
+  return row;
+}
+
+SeriesRow Simulation::record_row() {
+  SeriesRow row = diagnostics();
+  if (!scene_.drum.present) return row;
+  clock_contacts(particles_, time_, scene_.run.gravity);
+  const ChargeShape c =
+      measure_charge(particles_, walls_, scene_.drum, *domain_, time_, scene_.run.gravity);
+  row.toe_angle = c.toe;
+  row.shoulder_angle = c.shoulder;
+  row.surface_angle = c.surface_angle;
+  row.shell_arc = c.shell_arc;
+  row.com_x = c.com_x;
+  row.com_y = c.com_y;
+  row.airborne_fraction = c.airborne_fraction;
+  row.corotating_fraction = c.corotating_fraction;
+  const double sense = scene_.drum.speed < 0.0 ? -1.0 : 1.0;
+  mill_window_.add({row.time, row.drum_work, c.airborne_fraction, c.corotating_fraction,
+                    c.surface_angle, c.toe, c.shoulder,
+                    std::atan2(sense * c.com_x, -c.com_y) * 180.0 / std::numbers::pi});
+  const WindowSummary w = mill_window_.summary();
+  row.power_avg = w.span > 0.0 ? w.power : row.drum_power;
+  row.regime = regime_name(w.regime);
   return row;
 }
 

@@ -25,6 +25,7 @@
 #include "core/grinding.hpp"
 #include "core/integrators.hpp"
 #include "core/materials.hpp"
+#include "core/mill_analytics.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "core/run_state.hpp"
@@ -93,6 +94,13 @@ class Simulation final : private StepStages {
   void run_until(double t_end);
 
   SeriesRow diagnostics() const;
+  // The row of series.csv: diagnostics() and, with a drum, the charge's shape (collective); the
+  // sample joins the analysis window, whose average power and regime the row carries.
+  SeriesRow record_row();
+  // The analysis window's averages and regime (drum scenes; kUnknown until it is full).
+  WindowSummary mill_summary() const { return mill_window_.summary(); }
+  // Collision spectra (output.collision_spectra): this rank's histograms; nullptr when off.
+  const CollisionSpectra* spectra() const { return spectra_.get(); }
   // Start a new averaging window for the `passes` column (after a series row is written).
   void reset_pass_window();
   double time() const override { return time_; }
@@ -154,6 +162,7 @@ class Simulation final : private StepStages {
   // energy the change released booked as dissipated (collective).
   void population_step();
   void grinding_row(SeriesRow& row) const;
+  void set_up_analytics(const Resumption* resume);
   // This rank's kinetic, rotational, potential and elastic energy.
   double local_energy() const;
   // A guard fired (collective: every rank builds the same message). Throws UnstableError,
@@ -183,6 +192,9 @@ class Simulation final : private StepStages {
   // Energy ledger: cumulative over the run (this rank's share).
   double dissipated_ = 0.0;
   double drive_work_ = 0.0;
+  double drum_work_ = 0.0;  // of the drum's drive alone
+  MillWindow mill_window_;
+  std::unique_ptr<CollisionSpectra> spectra_;
   // The energy balance at the start, and the energy then in motion and in the springs.
   double balance0_ = 0.0, motion0_ = 0.0, potential0_ = 0.0, energy_floor_ = 0.0;
   bool baseline_taken_ = false;

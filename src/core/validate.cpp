@@ -80,8 +80,7 @@ double particle_memory_bytes(const Scene& scene, double particles) {
   Scene models;
   models.materials = scene.materials;
   models.interactions = scene.interactions;
-  models.contact = scene.contact;
-  models.contact.track_breakage = scene.breakage.present;
+  models.contact = active_contact(scene);
   models.run.integrator = scene.run.integrator;
   const double width = static_cast<double>(ContactEngine(models).history_slots().size());
   // A pair: local indices i, j (4 bytes each), ids (8 each), history and trial slots (8 each).

@@ -67,6 +67,7 @@ Walls::Walls(const Scene& scene) {
         const Vec2 p2 = (inner - l.height) * radial + 0.5 * l.width * side;
         for (auto [a, b] : {std::pair{p0, p1}, std::pair{p1, p2}, std::pair{p2, p3}}) {
           WallElement e;
+          e.part = WallPart::kLifter;
           e.body = 0;
           e.material = lmat;
           e.a_ref = a;
@@ -83,6 +84,7 @@ Walls::Walls(const Scene& scene) {
     body.velocity = w.velocity;
     bodies_.push_back(body);
     WallElement e;
+    e.part = WallPart::kWall;
     e.body = static_cast<int>(bodies_.size()) - 1;
     e.material = find_material(scene, w.material);
     e.a_ref = {0.0, 0.0};
@@ -144,6 +146,38 @@ WallGeometry Walls::geometry(int element, Vec2 x, double r) const {
   g.delta = r - dist;
   g.point = q;
   return g;
+}
+
+std::vector<std::vector<Vec2>> wall_outlines(const Walls& walls, int circle_points) {
+  std::vector<std::vector<Vec2>> out;
+  const WallElement* previous = nullptr;  // the segment that ended the last polyline
+  for (const WallElement& e : walls.elements()) {
+    const WallBody& body = walls.bodies()[e.body];
+    if (e.kind == WallKind::kCircle) {
+      const int n = std::max(circle_points, 3);
+      const Vec2 c = body.center + body.offset;
+      std::vector<Vec2> circle;
+      for (int k = 0; k < n; ++k) {
+        const double phi = body.angle + 2.0 * std::numbers::pi * k / n;
+        circle.push_back(c + e.radius * Vec2{std::cos(phi), std::sin(phi)});
+      }
+      circle.push_back(circle.front());
+      out.push_back(std::move(circle));
+      previous = nullptr;
+      continue;
+    }
+    if (previous != nullptr && previous->body == e.body && previous->b_ref == e.a_ref)
+      out.back().push_back(e.b);
+    else
+      out.push_back({e.a, e.b});
+    previous = &e;
+  }
+  // A chain that comes back to its start (the polygon) is closed exactly.
+  for (std::vector<Vec2>& line : out) {
+    if (line.size() >= 4 && norm(line.back() - line.front()) <= 1e-9 * norm(line[1] - line[0]))
+      line.back() = line.front();
+  }
+  return out;
 }
 
 }  // namespace dem2d

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "core/scene.hpp"
@@ -31,9 +32,12 @@ struct WallBody {
 };
 
 enum class WallKind { kCircle, kSegment };
+// What an element belongs to: the drum's shell, a lifter bar (on the drum body), a [[wall]].
+enum class WallPart : std::int8_t { kShell, kLifter, kWall };
 
 struct WallElement {
   WallKind kind = WallKind::kSegment;
+  WallPart part = WallPart::kShell;
   int body = 0;
   int material = 0;
   double radius = 0.0;    // circle
@@ -94,6 +98,15 @@ class Walls {
   double rotating_reach_ = 0.0;
   std::vector<Vec2> rotation_;  // (cos, sin) of each body's angle (scratch of update)
 };
+
+// The walls' outlines at their current time (the last update), in the lab frame, for pictures
+// (snapshots.xmf): one polyline per part. The drum's circle as `circle_points` points (at least
+// 3) starting at the drum's angle, closed (its first point repeated at the end); a polygonal
+// drum as its N sides chained, closed the same way (N + 1 points); each lifter as its three
+// exposed sides (4 points, both feet on the shell); each [[wall]] segment as its 2 ends. In
+// element order: the drum, its lifters, then the walls. Consecutive segments of one body whose
+// ends meet (in the body frame, exactly) are chained into one polyline.
+std::vector<std::vector<Vec2>> wall_outlines(const Walls& walls, int circle_points = 256);
 
 // Drum speed and angle at time t for a linear ramp from 0 to `speed` over `ramp` seconds.
 double ramp_speed(double speed, double ramp, double t);

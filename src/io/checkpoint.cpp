@@ -66,27 +66,28 @@ std::vector<std::pair<const char*, double*>> share_slots(RunState& s) {
   return {{"dissipated", &s.rank_dissipated},
           {"drive_work", &s.rank_drive_work},
           {"fed_energy", &s.grinding.rank_fed_energy},
-          {"discharged_energy", &s.grinding.rank_discharged_energy}};
+          {"discharged_energy", &s.grinding.rank_discharged_energy},
+          {"drum_work", &s.rank_drum_work}};
 }
 
-void write_field(h5::ParallelFile& file, const std::string& name, const h5::RowRange& rows,
-                 const FieldBase& f) {
-  if (const auto* d = dynamic_cast<const Field<double>*>(&f))
-    return file.write_rows(name, rows, d->data());
-  if (const auto* v = dynamic_cast<const Field<Vec2>*>(&f))
-    return file.write_rows(name, rows, reinterpret_cast<const double*>(v->data()), 2);
-  if (const auto* i = dynamic_cast<const Field<std::int64_t>*>(&f))
-    return file.write_rows(name, rows, i->data());
-  if (const auto* i = dynamic_cast<const Field<std::int32_t>*>(&f))
-    return file.write_rows(name, rows, i->data());
-  throw std::logic_error("checkpoint: particle field " + f.name() + " has no HDF5 type");
-}
-
-// The memory type a field is read back with (a Vec2 is two doubles).
-hid_t memory_type(const FieldBase& f) {
-  if (dynamic_cast<const Field<std::int64_t>*>(&f)) return H5T_NATIVE_INT64;
-  if (dynamic_cast<const Field<std::int32_t>*>(&f)) return H5T_NATIVE_INT32;
-  return H5T_NATIVE_DOUBLE;
+// The mill analytics (/analysis): the window's samples, 8 values each (every rank holds the
+// same), and the collision spectra summed over ranks (collective).
+constexpr std::size_t kSampleValues = 8;
+void write_analysis(h5::ParallelFile& file, const RunState& s) {
+  file.create_group("/analysis");
+  std::vector<double> window;
+  for (const MillSample& m : s.mill_samples)
+    window.insert(window.end(), {m.time, m.drum_work, m.airborne, m.corotating, m.surface_angle,
+                                 m.toe, m.shoulder, m.charge_angle});
+  file.write_rows("/analysis/window", h5::rank0_rows(file.comm(), window.size()), window.data());
+  std::vector<std::int64_t> counts = s.spectra_counts;
+  std::vector<double> energies = s.spectra_energies;
+  mpi::sum_in_place(file.comm(), std::span<std::int64_t>(counts));
+  mpi::sum_in_place(file.comm(), std::span<double>(energies));
+  file.write_rows("/analysis/spectra_counts", h5::rank0_rows(file.comm(), counts.size()),
+                  counts.data());
+  file.write_rows("/analysis/spectra_energies", h5::rank0_rows(file.comm(), energies.size()),
+                  energies.data());
 }
 
 // The resolved deck a checkpoint keeps and compares: without its [[particle]] tables (initial
@@ -125,12 +126,13 @@ void write_state(h5::ParallelFile& file, const Simulation& sim, int ranks) {
   file.write_strings("/guards/kind", kinds);
   file.write_strings("/guards/first", firsts);
   file.write_rows("/guards/count", h5::rank0_rows(file.comm(), counts.size()), counts.data());
+  write_analysis(file, s);
 }
 
 void write_particles(h5::ParallelFile& file, const ParticleStore& p) {
   file.create_group("/particles");
   const h5::RowRange rows = h5::row_range(file.comm(), p.n_owned());
-  for (const FieldBase* f : p.fields()) write_field(file, "/particles/" + f->name(), rows, *f);
+  for (const FieldBase* f : p.fields()) file.write_field("/particles/" + f->name(), rows, *f);
 }
 
 void write_histories(h5::ParallelFile& file, const HistoryRecords& h) {
@@ -229,6 +231,22 @@ std::vector<std::string> Reader::strings(const std::string& name) const {
   return out;
 }
 
+void read_analysis(const Reader& in, RunState& s) {
+  std::vector<double> window(in.shape("/analysis/window")[0]);
+  if (window.size() % kSampleValues != 0) in.fail("/analysis/window has the wrong length");
+  if (!window.empty()) in.read("/analysis/window", H5T_NATIVE_DOUBLE, window.data());
+  for (std::size_t k = 0; k < window.size(); k += kSampleValues) {
+    const double* v = window.data() + k;
+    s.mill_samples.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
+  }
+  s.spectra_counts.resize(in.shape("/analysis/spectra_counts")[0]);
+  s.spectra_energies.resize(in.shape("/analysis/spectra_energies")[0]);
+  if (!s.spectra_counts.empty())
+    in.read("/analysis/spectra_counts", H5T_NATIVE_INT64, s.spectra_counts.data());
+  if (!s.spectra_energies.empty())
+    in.read("/analysis/spectra_energies", H5T_NATIVE_DOUBLE, s.spectra_energies.data());
+}
+
 RunState read_state(const Reader& in, int my_rank, int my_size) {
   RunState s;
   if (in.string_attribute("format") != kCheckpointFormat)
@@ -262,23 +280,25 @@ RunState read_state(const Reader& in, int my_rank, int my_size) {
   if (!counts.empty()) in.read("/guards/count", H5T_NATIVE_INT64, counts.data());
   for (std::size_t k = 0; k < kinds.size(); ++k)
     s.guards.push_back({kinds[k], counts[k], firsts[k]});
+  read_analysis(in, s);
   return s;
 }
 
 void read_particles(const Reader& in, const Scene& scene, Resumption& r) {
   ParticleStore layout;  // the fields this scene's particles carry
   if (scene.breakage.present) layout.enable_damage();
+  if (scene.drum.present) layout.enable_last_contact();
   r.n_particles = static_cast<std::size_t>(in.shape("/particles/id")[0]);
   for (const FieldBase* f : layout.fields()) {
     const std::string name = "/particles/" + f->name();
     if (!in.has(name.c_str())) in.fail("it holds no particle field '" + f->name() + "'");
     const std::array<hsize_t, 2> dims = in.shape(name);
     const std::size_t bytes = r.n_particles * f->bytes_per_item();
-    const std::size_t value_bytes = memory_type(*f) == H5T_NATIVE_INT32 ? 4 : 8;
+    const std::size_t value_bytes = h5::memory_type(*f) == H5T_NATIVE_INT32 ? 4 : 8;
     if (dims[0] != r.n_particles || dims[1] * value_bytes != f->bytes_per_item())
       in.fail("its particle field '" + f->name() + "' has the wrong shape");
     std::vector<std::byte> column(bytes);
-    if (bytes) in.read(name, memory_type(*f), column.data());
+    if (bytes) in.read(name, h5::memory_type(*f), column.data());
     r.columns.push_back(std::move(column));
   }
 }

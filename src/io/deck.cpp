@@ -521,6 +521,23 @@ std::string element_choices(const toml::array& array) {
   return text;
 }
 
+// A --set of one key of an alternative group (deck_schema.hpp) removes the deck's value of the
+// others in the same table. One set by another --set stays, and the rules between keys refuse
+// the pair.
+void drop_alternatives(toml::table& table, std::string_view schema, std::string_view key,
+                       const Origins& origins) {
+  for (const deck::AlternativeKeys& group : deck::kAlternativeKeys) {
+    if (group.table != schema ||
+        std::find(group.keys.begin(), group.keys.end(), key) == group.keys.end())
+      continue;
+    for (const std::string_view other : group.keys) {
+      if (other.empty() || other == key) continue;
+      const toml::node* node = table.get(other);
+      if (node != nullptr && !origins.contains(node)) table.erase(other);
+    }
+  }
+}
+
 // Applies one override; a problem with the option itself (not with the value it sets, which
 // the validation reports) is an error naming the option.
 void apply_override(toml::table& root, const std::string& option, Origins& origins,
@@ -598,6 +615,7 @@ void apply_override(toml::table& root, const std::string& option, Origins& origi
     return;
   }
   if (const toml::node* old = table->get(last)) forget_origin(*old, origins);
+  drop_alternatives(*table, schema, last, origins);
   assign_override_value(*table, last, value);
   record_origin(*table->get(last), where, origins);
 }

@@ -138,6 +138,8 @@ inline constexpr Bound kPoissonRatio{0.0, 0.5, false, true};  // [0, 0.5): isotr
 inline constexpr Bound kFillFraction{0.0, 0.9, true, true};   // (0, 0.9): room left to place them
 inline constexpr Bound kAtLeastOne{1.0, Bound{}.hi, false, false};  // >= 1 (integers)
 inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (integers)
+inline constexpr Bound kSizeRatio{1.1, 1e3, false, false};          // [1.1, 1000]
+inline constexpr Bound kSizeEdge{1e-9, 10.0, false, true};          // [1 nm, 10 m)
 
 // A key's value once checked: a number, integer, bool, string (also a choice's word, or
 // "auto"), [x, y], or a list of names.
@@ -899,6 +901,26 @@ inline constexpr Key<OutputSpec> kOutputKeys[] = {
      .range = kPositive,
      .field = member<&OutputSpec::progress_interval>(),
      .doc = "wall-clock time between progress lines when stderr is not a terminal"},
+    {.name = "analysis_window",
+     .unit = "s",
+     .range = kPositive,
+     .field = member<&OutputSpec::analysis_window>(),
+     .doc = "drum scenes: the window of `series.csv`'s `power_avg` and `regime` (the last this "
+            "many seconds of rows)"},
+    {.name = "collision_spectra",
+     .type = Type::kBool,
+     .field = member<&OutputSpec::collision_spectra>(),
+     .doc = "bin every contact that ends by type, size class and peak normal strain energy "
+            "(`collisions.csv`); off costs nothing"},
+    {.name = "size_class_min",
+     .unit = "m",
+     .range = kSizeEdge,
+     .field = member<&OutputSpec::size_class_min>(),
+     .doc = "the collision spectra's smallest size-class edge (a diameter)"},
+    {.name = "size_class_ratio",
+     .range = kSizeRatio,
+     .field = member<&OutputSpec::size_class_ratio>(),
+     .doc = "the ratio between consecutive size-class edges (edges up to 10 m)"},
 };
 
 inline constexpr Key<Scene> kTopLevelKeys[] = {
@@ -956,6 +978,20 @@ constexpr void for_each_table(F&& f) {
 
 // True for the arrays of tables ("material", "drum.lifter"): a --set names one element.
 bool is_table_array(std::string_view path);
+
+// Keys of one table that say the same thing in different variables (a deck gives at most one
+// of each group). A --set of one of them replaces the deck's other one, so that a sweep can be
+// written in the engineer's own variable (--set drum.critical_fraction=0.7 on a deck that gives
+// drum.speed).
+struct AlternativeKeys {
+  std::string_view table;                // schema path: "drum", "fill", "material"
+  std::array<std::string_view, 3> keys;  // unused entries empty
+};
+inline constexpr std::array<AlternativeKeys, 3> kAlternativeKeys{{
+    {"drum", {"speed", "speed_rpm", "critical_fraction"}},
+    {"fill", {"count", "fill_fraction", "file"}},
+    {"material", {"poisson_ratio", "shear_modulus", ""}},
+}};
 
 // The key named `name` of a table (nullptr: none).
 template <class T>

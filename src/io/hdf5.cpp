@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <mutex>
+#include <stdexcept>
+#include <type_traits>
 
 #include "core/errors.hpp"
 #include "parallel/comm.hpp"
@@ -38,6 +41,55 @@ std::string error_stack_detail() {
 }
 
 }  // namespace
+
+static_assert(sizeof(Vec2) == 2 * sizeof(double) && std::is_standard_layout_v<Vec2>,
+              "a Vec2 field is written as N x 2 doubles");
+
+std::optional<FieldColumn> field_column(const FieldBase& field) {
+  if (const auto* d = dynamic_cast<const Field<double>*>(&field))
+    return FieldColumn{FieldColumn::kDouble, d->data(), 1};
+  if (const auto* v = dynamic_cast<const Field<Vec2>*>(&field))
+    return FieldColumn{FieldColumn::kDouble, v->data(), 2};
+  if (const auto* i = dynamic_cast<const Field<std::int64_t>*>(&field))
+    return FieldColumn{FieldColumn::kInt64, i->data(), 1};
+  if (const auto* i = dynamic_cast<const Field<std::int32_t>*>(&field))
+    return FieldColumn{FieldColumn::kInt32, i->data(), 1};
+  return std::nullopt;
+}
+
+const char* element_name(FieldColumn::Element element) {
+  switch (element) {
+    case FieldColumn::kInt64:
+      return "int64";
+    case FieldColumn::kInt32:
+      return "int32";
+    case FieldColumn::kDouble:
+      break;
+  }
+  return "double";
+}
+
+namespace {
+
+FieldColumn writable_column(const FieldBase& field) {
+  const std::optional<FieldColumn> c = field_column(field);
+  if (!c) throw std::logic_error("particle field '" + field.name() + "' has no HDF5 type");
+  return *c;
+}
+
+}  // namespace
+
+hid_t memory_type(const FieldBase& field) {
+  switch (writable_column(field).element) {
+    case FieldColumn::kInt64:
+      return H5T_NATIVE_INT64;
+    case FieldColumn::kInt32:
+      return H5T_NATIVE_INT32;
+    case FieldColumn::kDouble:
+      break;
+  }
+  return H5T_NATIVE_DOUBLE;
+}
 
 RowRange row_range(MPI_Comm comm, std::size_t local_count) {
   const auto count = static_cast<std::uint64_t>(local_count);
@@ -161,6 +213,26 @@ std::string ParallelFile::read_string_attribute(const std::string& object,
   return std::string(buffer.data());
 }
 
+std::vector<std::string> ParallelFile::read_strings(const std::string& name) const {
+  DatasetHandle d(check(H5Dopen2(file_.get(), name.c_str(), H5P_DEFAULT), "open dataset", name));
+  DatatypeHandle type(check(H5Dget_type(d.get()), "read the type of", name));
+  if (H5Tget_class(type.get()) != H5T_STRING || H5Tis_variable_str(type.get()) != 0)
+    throw IoError(fmt::format("{}: cannot read '{}': not fixed-length strings", path_, name));
+  DataspaceHandle space(check(H5Dget_space(d.get()), "read the shape of", name));
+  const hssize_t n = check(H5Sget_simple_extent_npoints(space.get()), "read the shape of", name);
+  const std::size_t width = H5Tget_size(type.get());
+  std::vector<char> buffer(static_cast<std::size_t>(n) * width + 1, '\0');
+  if (n > 0)
+    check(H5Dread(d.get(), type.get(), H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()),
+          "read dataset", name);
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+    const char* s = buffer.data() + k * width;
+    out.emplace_back(s, strnlen(s, width));
+  }
+  return out;
+}
+
 void ParallelFile::read_scalar_attribute(const std::string& object, const std::string& attribute,
                                          hid_t memory_type, void* value) const {
   const std::string what = object + "@" + attribute;
@@ -235,6 +307,20 @@ void ParallelFile::write_rows(const std::string& name, const RowRange& range,
 void ParallelFile::write_rows(const std::string& name, const RowRange& range,
                               const std::int32_t* data, std::size_t columns) {
   write_rows_typed(name, range, H5T_STD_I32LE, H5T_NATIVE_INT32, data, columns);
+}
+
+void ParallelFile::write_field(const std::string& name, const RowRange& range,
+                               const FieldBase& field) {
+  const FieldColumn c = writable_column(field);
+  switch (c.element) {
+    case FieldColumn::kInt64:
+      return write_rows(name, range, static_cast<const std::int64_t*>(c.data), c.columns);
+    case FieldColumn::kInt32:
+      return write_rows(name, range, static_cast<const std::int32_t*>(c.data), c.columns);
+    case FieldColumn::kDouble:
+      break;
+  }
+  write_rows(name, range, static_cast<const double*>(c.data), c.columns);
 }
 
 void ParallelFile::write_strings(const std::string& name, const std::vector<std::string>& values) {

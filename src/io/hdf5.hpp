@@ -19,11 +19,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "parallel/comm.hpp"  // MPI_Comm: the MPI-IO driver takes the communicator
+#include "core/particles.hpp"  // FieldBase: particle fields as datasets (field_column)
+#include "parallel/comm.hpp"   // MPI_Comm: the MPI-IO driver takes the communicator
 
 namespace dem2d::h5 {
 
@@ -76,6 +78,25 @@ RowRange row_range(MPI_Comm comm, std::size_t local_count);
 // The same range on every rank for data that rank 0 alone writes (a small table).
 RowRange rank0_rows(MPI_Comm comm, std::size_t count);
 
+// A particle field as the rows of a dataset (snapshots.h5, checkpoint.h5): one row per
+// particle of `columns` values of one element type. The one place that maps the store's field
+// types to HDF5: Field<double> (1 double), Field<Vec2> (2 doubles, x and y), Field<int64_t>,
+// Field<int32_t>.
+struct FieldColumn {
+  enum Element { kInt64, kInt32, kDouble };
+  Element element = kDouble;
+  const void* data = nullptr;  // the field's values, item 0 first
+  std::size_t columns = 1;     // values per particle: 1, or 2 for a Vec2
+};
+
+// The column of `field`; std::nullopt for a field of any other type.
+std::optional<FieldColumn> field_column(const FieldBase& field);
+// "int64", "int32" or "double": the name ParallelFile::DatasetShape::type gives the element.
+const char* element_name(FieldColumn::Element element);
+// The native memory type a field's values are read back with (a Vec2 as two doubles). Throws
+// std::logic_error for a field field_column() cannot hold.
+hid_t memory_type(const FieldBase& field);
+
 class ParallelFile {
  public:
   // Collective: creates `path` (truncating an existing file) with the MPI-IO driver.
@@ -123,6 +144,10 @@ class ParallelFile {
                   std::size_t columns = 1);
   void write_rows(const std::string& name, const RowRange& range, const std::int32_t* data,
                   std::size_t columns = 1);
+  // The first range.count items of the particle field `field` as the rows of the dataset
+  // `name` (field_column: the field's type decides the element type and the columns), as
+  // write_rows. Throws std::logic_error for a field field_column() cannot hold.
+  void write_field(const std::string& name, const RowRange& range, const FieldBase& field);
   // A 1-D dataset of fixed-length, null-terminated strings; `values` must be the same on all
   // ranks (rank 0's are written).
   void write_strings(const std::string& name, const std::vector<std::string>& values);
@@ -139,6 +164,8 @@ class ParallelFile {
   std::int64_t read_int64_attribute(const std::string& object, const std::string& attribute) const;
   // A fixed-length string attribute (what write_attribute writes for a std::string).
   std::string read_string_attribute(const std::string& object, const std::string& attribute) const;
+  // A 1-D dataset of fixed-length strings (what write_strings writes).
+  std::vector<std::string> read_strings(const std::string& name) const;
   // The element type and shape of the dataset `name`: type "int64", "int32" or "double"
   // (IoError for any other), `rows` its first dimension, `columns` its second (1 for a 1-D
   // dataset; IoError for more than 2 dimensions).

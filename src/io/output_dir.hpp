@@ -33,9 +33,10 @@ inline constexpr const char* kXdmfFile = "snapshots.xmf";
 inline constexpr const char* kProductFile = "product.csv";
 inline constexpr const char* kBreakagesFile = "breakages.csv";
 inline constexpr const char* kCheckpointFile = "checkpoint.h5";
-inline constexpr const char* kRunOutputs[] = {kRunJsonFile,   kSeriesFile,  kSnapshotsFile,
-                                              kXdmfFile,      kProductFile, kBreakagesFile,
-                                              kCheckpointFile};
+inline constexpr const char* kCollisionsFile = "collisions.csv";
+inline constexpr const char* kRunOutputs[] = {kRunJsonFile,    kSeriesFile,    kSnapshotsFile,
+                                              kXdmfFile,       kProductFile,   kBreakagesFile,
+                                              kCheckpointFile, kCollisionsFile};
 inline constexpr const char* kOutputLockName = ".dem2d.lock";
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and

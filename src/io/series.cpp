@@ -16,17 +16,17 @@
 namespace dem2d {
 
 namespace {
-bool written(const SeriesColumn& column, bool iterative, bool ore) {
+bool written(const SeriesColumn& column, bool iterative, bool ore, bool drum) {
   return column.only == SeriesOnly::kAlways ||
          (iterative && column.only == SeriesOnly::kIterative) ||
-         (ore && column.only == SeriesOnly::kOre);
+         (ore && column.only == SeriesOnly::kOre) || (drum && column.only == SeriesOnly::kDrum);
 }
 }  // namespace
 
-std::vector<std::string> series_columns(bool iterative, bool ore) {
+std::vector<std::string> series_columns(bool iterative, bool ore, bool drum) {
   std::vector<std::string> columns;
   for (const SeriesColumn& column : kSeriesColumns) {
-    if (written(column, iterative, ore)) columns.emplace_back(column.name);
+    if (written(column, iterative, ore, drum)) columns.emplace_back(column.name);
   }
   return columns;
 }
@@ -76,17 +76,18 @@ std::FILE* continue_csv(const std::string& path, const std::string& header, std:
 }
 
 SeriesWriter::SeriesWriter(const std::string& path, bool iterative, bool active, bool ore,
-                           std::int64_t continue_after_step)
-    : path_(path), iterative_(iterative), ore_(ore) {
+                           std::int64_t continue_after_step, bool drum)
+    : path_(path), iterative_(iterative), ore_(ore), drum_(drum) {
   if (!active) return;
-  const std::string header = fmt::format("{}", fmt::join(series_columns(iterative_, ore_), ","));
+  const std::string header =
+      fmt::format("{}", fmt::join(series_columns(iterative_, ore_, drum_), ","));
   if (continue_after_step >= 0) {
     file_.reset(continue_csv(path_, header, 1, static_cast<double>(continue_after_step)));
     return;
   }
   file_.reset(std::fopen(path_.c_str(), "w"));
   if (!file_) throw IoError(fmt::format("cannot create {}: {}", path_, std::strerror(errno)));
-  put(fmt::format("{}\n", fmt::join(series_columns(iterative_, ore_), ",")));
+  put(header + "\n");
 }
 
 SeriesWriter::~SeriesWriter() = default;  // fclose flushes; its status cannot be reported
@@ -103,7 +104,7 @@ void SeriesWriter::write(const SeriesRow& r) {
     }
   };
   for (const SeriesColumn& column : kSeriesColumns) {
-    if (!written(column, iterative_, ore_)) continue;
+    if (!written(column, iterative_, ore_, drum_)) continue;
     if (!line.empty()) line += ',';
     std::visit([&](auto member) { append(r.*member); }, column.value);
   }

@@ -25,13 +25,14 @@ enum class SeriesOnly {
   kAlways,
   kIterative,  // the iterative integrator
   kOre,        // ore scenes: [breakage], [feed] or [sieve]
+  kDrum,       // scenes with a [drum]: the mill analytics
 };
 
 // One column of series.csv.
 struct SeriesColumn {
   std::string_view name;
   std::string_view unit;  // "" in the docs: "–"
-  std::variant<double SeriesRow::*, std::int64_t SeriesRow::*> value;
+  std::variant<double SeriesRow::*, std::int64_t SeriesRow::*, const char * SeriesRow::*> value;
   SeriesOnly only = SeriesOnly::kAlways;
   std::string_view doc;  // the docs' "meaning" column (Markdown)
 };
@@ -87,11 +88,46 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
     {"discharged_energy", "J", &SeriesRow::discharged_energy, SeriesOnly::kOre,
      "ore scenes: kinetic, rotational and potential energy the discharged particles took out "
      "(a term of the energy balance)"},
+    {"shell_torque", "N m", &SeriesRow::shell_torque, SeriesOnly::kDrum,
+     "drum scenes: the part of `drum_torque` the shell's contacts take (`drum_torque` − "
+     "`lifter_torque`)"},
+    {"lifter_torque", "N m", &SeriesRow::lifter_torque, SeriesOnly::kDrum,
+     "drum scenes: the part of `drum_torque` the lifters' contacts take"},
+    {"shell_power", "W", &SeriesRow::shell_power, SeriesOnly::kDrum,
+     "drum scenes: `shell_torque` × drum angular speed"},
+    {"lifter_power", "W", &SeriesRow::lifter_power, SeriesOnly::kDrum,
+     "drum scenes: `lifter_torque` × drum angular speed"},
+    {"drum_work", "J", &SeriesRow::drum_work, SeriesOnly::kDrum,
+     "drum scenes: cumulative work of the drum's drive (`drive_work` without moving walls)"},
+    {"power_avg", "W", &SeriesRow::power_avg, SeriesOnly::kDrum,
+     "drum scenes: the drive's mean power over the last `output.analysis_window` seconds: the "
+     "change of `drum_work` over the window / its length (over the rows so far while the run "
+     "is younger than the window)"},
+    {"toe_angle", "deg", &SeriesRow::toe_angle, SeriesOnly::kDrum,
+     "drum scenes: where the charge meets the shell, from the downward vertical, positive in "
+     "the drum's sense of rotation (docs/models.md, \"Mill analytics\"); `nan` when the "
+     "particles line the whole shell"},
+    {"shoulder_angle", "deg", &SeriesRow::shoulder_angle, SeriesOnly::kDrum,
+     "drum scenes: where the charge leaves the shell, same convention"},
+    {"surface_angle", "deg", &SeriesRow::surface_angle, SeriesOnly::kDrum,
+     "drum scenes: the bed's free surface from the horizontal, rising towards the shoulder"},
+    {"shell_arc", "deg", &SeriesRow::shell_arc, SeriesOnly::kDrum,
+     "drum scenes: the arc of shell the charge covers (360: all of it)"},
+    {"com_x", "m", &SeriesRow::com_x, SeriesOnly::kDrum,
+     "drum scenes: the charge's centre of mass from the drum centre, horizontal"},
+    {"com_y", "m", &SeriesRow::com_y, SeriesOnly::kDrum, "drum scenes: the same, vertical"},
+    {"airborne_fraction", "", &SeriesRow::airborne_fraction, SeriesOnly::kDrum,
+     "drum scenes: particles without any contact (in free flight) / all particles"},
+    {"corotating_fraction", "", &SeriesRow::corotating_fraction, SeriesOnly::kDrum,
+     "drum scenes: particles above the drum's axis moving with the shell / all particles"},
+    {"regime", "", &SeriesRow::regime, SeriesOnly::kDrum,
+     "drum scenes: slumping, rolling, cascading, cataracting or centrifuging over the window "
+     "(docs/models.md, \"Regimes\"); `-` until the run is one window old"},
 };
 
 // The column names of series.csv, in order ("passes" for the iterative integrator, then the ore
-// columns for ore scenes).
-std::vector<std::string> series_columns(bool iterative, bool ore = false);
+// columns for ore scenes, then the mill analytics for drum scenes).
+std::vector<std::string> series_columns(bool iterative, bool ore = false, bool drum = false);
 
 // The column table of docs/output.md (between "<!-- columns: series.csv -->" and
 // "<!-- end columns -->"): header, separator and one line per column, each ending in '\n'.
@@ -111,7 +147,7 @@ class SeriesWriter {
   // (a restart), keeps the rows up to that step and appends after them (continue_csv). Throws
   // IoError "cannot create PATH: REASON" when it cannot (active writer only).
   SeriesWriter(const std::string& path, bool iterative, bool active, bool ore = false,
-               std::int64_t continue_after_step = -1);
+               std::int64_t continue_after_step = -1, bool drum = false);
   ~SeriesWriter();  // flushes and closes; never throws
   SeriesWriter(const SeriesWriter&) = delete;
   SeriesWriter& operator=(const SeriesWriter&) = delete;
@@ -130,6 +166,7 @@ class SeriesWriter {
   std::string path_;
   bool iterative_;
   bool ore_;
+  bool drum_;
   std::unique_ptr<std::FILE, Closer> file_;
 };
 

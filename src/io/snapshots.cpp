@@ -5,14 +5,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
-#include <type_traits>
 #include <utility>
 
 #include "core/errors.hpp"
@@ -23,60 +24,74 @@ namespace {
 
 namespace fs = std::filesystem;
 
-static_assert(sizeof(Vec2) == 2 * sizeof(double) && std::is_standard_layout_v<Vec2>,
-              "a Vec2 array is written as an N x 2 array of doubles");
-
-const double* as_doubles(const Field<Vec2>& f) { return reinterpret_cast<const double*>(f.data()); }
-
 // The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
 constexpr const char* kGeometry = "position";
+// The registry field of material rows: its datasets carry the material names (attribute names).
+constexpr const char* kMaterial = "material";
+// The derived dataset every snapshot holds after the registry's: |velocity|.
+const SnapshotDataset kSpeed{"speed", "double", 1, "m/s",
+                             "speed of the centre, the norm of velocity"};
 
-// The groups of snapshots.h5: complete snapshots, the one being written, the XDMF helpers.
+// The groups of snapshots.h5: complete snapshots, their wall outlines, the one being written,
+// the XDMF helpers.
 const std::string kSnapshotsGroup = "/snapshots";
+const std::string kWallsGroup = "/walls";
 const std::string kStagingGroup = "/incomplete";
 const std::string kXdmfGroup = "/xdmf";
 
-// snapshots.xmf is kXdmfHeader, one grid per snapshot (xdmf_grid), kXdmfTrailer.
-constexpr std::string_view kXdmfHeader =
-    "<?xml version=\"1.0\" ?>\n"
-    "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
-    "  <Domain>\n"
-    "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+// Where snapshot NAME's wall outline is staged (beside its particles, /incomplete/NAME).
+std::string staged_walls(const std::string& name) { return kStagingGroup + "/walls_" + name; }
+
+// snapshots.xmf is xdmf_header(), one grid per snapshot (xdmf_grid), kXdmfTrailer.
 constexpr std::string_view kXdmfTrailer =
     "    </Grid>\n"
     "  </Domain>\n"
     "</Xdmf>\n";
 
-// A registry field as the writer sees it: its values, element type and values per particle.
-struct Column {
-  enum Element { kInt64, kInt32, kDouble } element;
-  const void* data;
-  std::size_t columns;
-};
-
-// The column types snapshots can hold; std::nullopt for any other.
-std::optional<Column> column_of(const FieldBase& f) {
-  if (const auto* d = dynamic_cast<const Field<double>*>(&f))
-    return Column{Column::kDouble, d->data(), 1};
-  if (const auto* v = dynamic_cast<const Field<Vec2>*>(&f))
-    return Column{Column::kDouble, as_doubles(*v), 2};
-  if (const auto* i = dynamic_cast<const Field<std::int64_t>*>(&f))
-    return Column{Column::kInt64, i->data(), 1};
-  if (const auto* i = dynamic_cast<const Field<std::int32_t>*>(&f))
-    return Column{Column::kInt32, i->data(), 1};
-  return std::nullopt;
+// `text` with the five XML special characters escaped, for an attribute value.
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
 }
 
-const char* type_name(Column::Element e) {
-  switch (e) {
-    case Column::kInt64:
-      return "int64";
-    case Column::kInt32:
-      return "int32";
-    case Column::kDouble:
-      break;
-  }
-  return "double";
+// "0=steel,1=iron ore": each material's row of /materials and its name.
+std::string material_lookup(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size(); ++k)
+    out += fmt::format("{}{}={}", k == 0 ? "" : ",", k, names[k]);
+  return out;
+}
+
+std::string xdmf_header(const std::vector<std::string>& material_names) {
+  std::string text =
+      "<?xml version=\"1.0\" ?>\n"
+      "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
+      "  <Domain>\n";
+  if (!material_names.empty())
+    text += fmt::format("    <Information Name=\"material_names\" Value=\"{}\"/>\n",
+                        xml_escape(material_lookup(material_names)));
+  return text + "    <Grid Name=\"mill\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
 }
 
 // XDMF's NumberType and Precision of a SnapshotDataset::type.
@@ -84,21 +99,6 @@ std::pair<const char*, int> xdmf_number(const std::string& type) {
   if (type == "int64") return {"Int", 8};
   if (type == "int32") return {"Int", 4};
   return {"Float", 8};
-}
-
-void write_column(h5::ParallelFile& file, const std::string& name, const h5::RowRange& rows,
-                  const Column& c) {
-  switch (c.element) {
-    case Column::kInt64:
-      file.write_rows(name, rows, static_cast<const std::int64_t*>(c.data), c.columns);
-      return;
-    case Column::kInt32:
-      file.write_rows(name, rows, static_cast<const std::int32_t*>(c.data), c.columns);
-      return;
-    case Column::kDouble:
-      file.write_rows(name, rows, static_cast<const double*>(c.data), c.columns);
-      return;
-  }
 }
 
 // One XDMF DataItem that reads a whole dataset of snapshots.h5.
@@ -118,11 +118,26 @@ std::string point_attribute(const std::string& attribute, const std::string& h5_
                             const std::string& dataset, std::uint64_t rows, int columns,
                             const char* number_type, int precision) {
   return fmt::format(
-      "        <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n"
-      "          {}\n"
-      "        </Attribute>\n",
+      "          <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n"
+      "            {}\n"
+      "          </Attribute>\n",
       attribute, columns == 1 ? "Scalar" : "Vector",
       hdf_item(h5_name, dataset, rows, columns, number_type, precision));
+}
+
+// The material names as field data (Center="Grid", one value in the file itself): ParaView
+// lists an array "material: NAME" holding the material's row, in its Information panel and
+// spreadsheet view, with every XDMF reader (none reads strings into field data).
+std::string material_attributes(const std::vector<std::string>& material_names) {
+  std::string text;
+  for (std::size_t k = 0; k < material_names.size(); ++k)
+    text += fmt::format(
+        "          <Attribute Name=\"{}: {}\" AttributeType=\"Scalar\" Center=\"Grid\">\n"
+        "            <DataItem Dimensions=\"1\" NumberType=\"Int\" Precision=\"4\" "
+        "Format=\"XML\">{}</DataItem>\n"
+        "          </Attribute>\n",
+        kMaterial, xml_escape(material_names[k]), k);
+  return text;
 }
 
 // The dataset holding 0, 1, ..., n - 1: the connectivity of a Polyvertex topology of n points.
@@ -145,8 +160,10 @@ std::optional<std::uint64_t> snapshot_index(const std::string& name) {
   return std::stoull(name);
 }
 
-// The <Grid> of one snapshot in snapshots.xmf; `h5` is the HDF5 file's name.
-std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r) {
+// The particles of one snapshot: a Polyvertex grid, position as the XY geometry, every other
+// dataset as a point attribute, the material names as field data.
+std::string particles_grid(const std::string& h5, const SnapshotInfo& r,
+                           const std::vector<std::string>& material_names) {
   const std::string g = kSnapshotsGroup + "/" + r.name;
   const std::uint64_t n = r.particles;
   const std::string topology =
@@ -154,22 +171,53 @@ std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r) {
           ? "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"0\" NodesPerElement=\"1\"/>"
           : fmt::format(
                 "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
-                "NodesPerElement=\"1\">\n          {}\n        </Topology>",
+                "NodesPerElement=\"1\">\n            {}\n          </Topology>",
                 n, hdf_item(h5, polyvertex_dataset(n), n, 1, "Int", 8));
   std::string text = fmt::format(
-      "      <Grid Name=\"snapshot_{}\" GridType=\"Uniform\">\n"
-      "        <Time Value=\"{:.17g}\"/>\n"
-      "        {}\n"
-      "        <Geometry GeometryType=\"XY\">\n"
+      "        <Grid Name=\"particles\" GridType=\"Uniform\">\n"
       "          {}\n"
-      "        </Geometry>\n",
-      r.name, r.time, topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
+      "          <Geometry GeometryType=\"XY\">\n"
+      "            {}\n"
+      "          </Geometry>\n",
+      topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
   for (const SnapshotDataset& d : r.datasets) {
     if (d.name == kGeometry) continue;
     const auto [number_type, precision] = xdmf_number(d.type);
     text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
                             number_type, precision);
   }
+  return text + material_attributes(material_names) + "        </Grid>\n";
+}
+
+// The wall outline of one snapshot: line segments (a Polyline topology of 2 nodes per element,
+// the connectivity /walls/NNNNNN/segments) between the XY points /walls/NNNNNN/points.
+std::string walls_grid(const std::string& h5, const SnapshotInfo& r) {
+  const std::string g = kWallsGroup + "/" + r.name;
+  return fmt::format(
+      "        <Grid Name=\"walls\" GridType=\"Uniform\">\n"
+      "          <Topology TopologyType=\"Polyline\" NumberOfElements=\"{}\" "
+      "NodesPerElement=\"2\">\n"
+      "            {}\n"
+      "          </Topology>\n"
+      "          <Geometry GeometryType=\"XY\">\n"
+      "            {}\n"
+      "          </Geometry>\n"
+      "        </Grid>\n",
+      r.wall_segments, hdf_item(h5, g + "/segments", r.wall_segments, 2, "Int", 8),
+      hdf_item(h5, g + "/points", r.wall_points, 2, "Float", 8));
+}
+
+// The <Grid> of one snapshot in snapshots.xmf, a spatial collection at the snapshot's time of
+// the particles and (when the snapshot has one) the wall outline; `h5` is the HDF5 file's name.
+// ParaView's three XDMF readers show it as a multiblock of two blocks per time step.
+std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
+                      const std::vector<std::string>& material_names) {
+  std::string text = fmt::format(
+      "      <Grid Name=\"snapshot_{}\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+      "        <Time Value=\"{:.17g}\"/>\n",
+      r.name, r.time);
+  text += particles_grid(h5, r, material_names);
+  if (r.wall_segments > 0) text += walls_grid(h5, r);
   return text + "      </Grid>\n";
 }
 
@@ -216,12 +264,14 @@ std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles) {
   std::vector<SnapshotDataset> out;
   for (const FieldBase* f : particles.fields()) {
     if (!f->meta().snapshot) continue;
-    const std::optional<Column> c = column_of(*f);
+    const std::optional<h5::FieldColumn> c = h5::field_column(*f);
     if (!c)
       throw std::logic_error("SnapshotWriter: field '" + f->name() +
                              "' is marked for snapshots but its type cannot be written");
-    out.push_back({f->name(), type_name(c->element), c->columns, f->meta().unit, f->meta().doc});
+    out.push_back(
+        {f->name(), h5::element_name(c->element), c->columns, f->meta().unit, f->meta().doc});
   }
+  out.push_back(kSpeed);
   return out;
 }
 
@@ -252,6 +302,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
     file_.emplace(h5::ParallelFile::create(comm_, h5_path_));
     write_materials(materials);
     file_->create_group(kSnapshotsGroup);
+    file_->create_group(kWallsGroup);
     file_->create_group(kStagingGroup);
     file_->create_group(kXdmfGroup);
     file_->flush();
@@ -293,9 +344,9 @@ SnapshotWriter::~SnapshotWriter() = default;
 void SnapshotWriter::write_materials(const std::vector<MaterialSpec>& materials) {
   file_->create_group("/materials");
   const h5::RowRange rows = h5::rank0_rows(comm_, materials.size());
-  std::vector<std::string> names;
-  for (const auto& m : materials) names.push_back(m.name);
-  file_->write_strings("/materials/name", names);
+  material_names_.clear();
+  for (const auto& m : materials) material_names_.push_back(m.name);
+  file_->write_strings("/materials/name", material_names_);
   auto column = [&](const char* name, double MaterialSpec::*member) {
     std::vector<double> values;
     for (const auto& m : materials) values.push_back(m.*member);
@@ -326,15 +377,51 @@ SnapshotInfo SnapshotWriter::describe(const ParticleStore& p, double time, std::
   return record;
 }
 
+// A wall outline as snapshots.h5 holds it: the points of the polylines, and each polyline's
+// segments as pairs of point rows. A closed polyline (its last point its first) reuses its
+// first point; a polyline of fewer than 2 points is left out.
+struct SnapshotWriter::WallData {
+  std::vector<double> points;          // x0, y0, x1, y1, ...
+  std::vector<std::int64_t> segments;  // a0, b0, a1, b1, ...
+};
+
+SnapshotWriter::WallData SnapshotWriter::wall_data(std::span<const std::vector<Vec2>> outlines) {
+  WallData w;
+  for (const std::vector<Vec2>& line : outlines) {
+    if (line.size() < 2) continue;
+    const auto first = static_cast<std::int64_t>(w.points.size() / 2);
+    const bool closed = line.size() > 2 && line.back() == line.front();
+    const std::size_t own = closed ? line.size() - 1 : line.size();  // points it adds
+    for (std::size_t k = 0; k < own; ++k) {
+      w.points.push_back(line[k].x);
+      w.points.push_back(line[k].y);
+    }
+    for (std::size_t k = 0; k + 1 < line.size(); ++k) {
+      w.segments.push_back(first + static_cast<std::int64_t>(k));
+      w.segments.push_back(first + static_cast<std::int64_t>((k + 1) % own));
+    }
+  }
+  return w;
+}
+
 void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
+                           std::span<const std::vector<Vec2>> walls,
                            std::span<const ExtraField> extra) {
   if (!file_) throw std::logic_error("SnapshotWriter::write after close");
   SnapshotInfo record = describe(p, time, step, extra);
+  const WallData outline = wall_data(walls);
+  std::array<int, 2> wall_rows{static_cast<int>(outline.points.size() / 2),
+                               static_cast<int>(outline.segments.size() / 2)};
+  mpi::broadcast(comm_, wall_rows, 0);  // rank 0's outline is written
+  record.wall_points = static_cast<std::uint64_t>(wall_rows[0]);
+  record.wall_segments = static_cast<std::uint64_t>(wall_rows[1]);
   std::uint64_t row_bytes = 0;
   for (const SnapshotDataset& d : record.datasets)
     row_bytes += d.columns * (d.type == "int32" ? 4 : 8);
   const std::uint64_t total = h5::row_range(comm_, p.n_owned()).total;
-  ensure_free_space(comm_, h5_path_, total * row_bytes + 2048 * record.datasets.size() + 16384);
+  ensure_free_space(comm_, h5_path_,
+                    total * row_bytes + 16 * (record.wall_points + record.wall_segments) +
+                        2048 * (record.datasets.size() + 2) + 16384);
   const std::string staged = kStagingGroup + "/" + record.name;
   const std::string published = kSnapshotsGroup + "/" + record.name;
   std::string error;
@@ -342,12 +429,14 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
     if (failed_) clear_failed_write(record.name);
     const h5::RowRange rows = h5::row_range(comm_, p.n_owned());
     record.particles = rows.total;
-    stage(staged, record, rows, p, extra);
+    stage(staged, record, rows, p, extra, outline);
   } catch (const IoError& e) {
     error = e.what();
   }
   agree(error);
   try {
+    if (record.wall_segments > 0)  // the outline first: a published snapshot has its outline
+      file_->move_link(staged_walls(record.name), kWallsGroup + "/" + record.name);
     file_->move_link(staged, published);  // complete: readers may see it from now on
     file_->flush();                       // a crash later still leaves this snapshot readable
   } catch (const IoError& e) {
@@ -369,10 +458,11 @@ void SnapshotWriter::agree(const std::string& local_error) {
 }
 
 // Before the write after a failed one: removes what the failed write of snapshot `name` left
-// (its staging group; its published group if it failed after the move, before it was
+// (its staging groups; its published groups if it failed after a move, before it was
 // recorded; a connectivity dataset no recorded snapshot uses), so the write can start afresh.
 void SnapshotWriter::clear_failed_write(const std::string& name) {
-  for (const std::string& g : {kStagingGroup + "/" + name, kSnapshotsGroup + "/" + name})
+  for (const std::string& g : {kStagingGroup + "/" + name, staged_walls(name),
+                               kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name})
     if (file_->link_exists(g)) file_->remove_link(g);
   for (const std::string& member : file_->group_members(kXdmfGroup)) {
     const std::optional<std::uint64_t> n = polyvertex_size(member);
@@ -381,15 +471,17 @@ void SnapshotWriter::clear_failed_write(const std::string& name) {
   failed_ = false;
 }
 
-// The snapshot as the staging group `group`, with the connectivity it needs, flushed.
+// The snapshot as the staging group `group`, with the connectivity it needs and its wall
+// outline (staged_walls), flushed.
 void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
                            const h5::RowRange& rows, const ParticleStore& p,
-                           std::span<const ExtraField> extra) {
+                           std::span<const ExtraField> extra, const WallData& walls) {
   file_->create_group(group, /*track_order=*/true);  // resume() reads the datasets in order
   file_->write_attribute(group, "time", record.time);
   file_->write_attribute(group, "step", record.step);
   write_datasets(group, rows, p, extra);
   if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) write_polyvertex(rows);
+  if (record.wall_segments > 0) write_walls(staged_walls(record.name), record, walls);
   if (fail_before_dataset_) {  // testing: past the last dataset, fail before the flush
     fail_before_dataset_.reset();
     throw IoError(fmt::format("{}: cannot flush '{}': injected failure", h5_path_, group));
@@ -397,8 +489,9 @@ void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
   file_->flush();
 }
 
-// The registry's snapshot fields in registry order, then the extra fields; each dataset with
-// its unit and description as attributes, so a file explains itself.
+// The registry's snapshot fields in registry order, then speed, then the extra fields; each
+// dataset with its unit and description as attributes, so a file explains itself, and the
+// material rows with the material names (attribute `names`, "0=steel,1=ore").
 void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange& rows,
                                     const ParticleStore& p, std::span<const ExtraField> extra) {
   std::size_t written = 0;
@@ -417,15 +510,42 @@ void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange
     if (!f->meta().snapshot) continue;
     const std::string name = group + "/" + f->name();
     begin(name);
-    write_column(*file_, name, rows, *column_of(*f));  // snapshot_datasets checked the type
+    file_->write_field(name, rows, *f);  // snapshot_datasets checked the type
     describe(name, f->meta().unit, f->meta().doc);
+    if (f->name() == kMaterial)
+      file_->write_attribute(name, "names", material_lookup(material_names_));
   }
+  const std::string speed_name = group + "/" + kSpeed.name;
+  begin(speed_name);
+  std::vector<double> speed(rows.count);
+  for (std::size_t i = 0; i < speed.size(); ++i) speed[i] = norm(p.vel[i]);
+  file_->write_rows(speed_name, rows, speed.data());
+  describe(speed_name, kSpeed.unit, kSpeed.doc);
   for (const ExtraField& e : extra) {
     const std::string name = group + "/" + e.name;
     begin(name);
     file_->write_rows(name, rows, e.values.data());
     describe(name, e.unit, e.doc);
   }
+}
+
+// The wall outline of snapshot `record` as the group `group`: its time and step, the points
+// (M x 2) and the segments (S x 2 point rows); rank 0's, the same on every rank.
+void SnapshotWriter::write_walls(const std::string& group, const SnapshotInfo& record,
+                                 const WallData& walls) {
+  file_->create_group(group);
+  file_->write_attribute(group, "time", record.time);
+  file_->write_attribute(group, "step", record.step);
+  const std::string points = group + "/points";
+  file_->write_rows(points, h5::rank0_rows(comm_, record.wall_points), walls.points.data(), 2);
+  file_->write_attribute(points, "unit", std::string("m"));
+  file_->write_attribute(points, "doc", std::string("x and y of the outline's points, lab frame"));
+  const std::string segments = group + "/segments";
+  file_->write_rows(segments, h5::rank0_rows(comm_, record.wall_segments), walls.segments.data(),
+                    2);
+  file_->write_attribute(segments, "unit", std::string("1"));
+  file_->write_attribute(segments, "doc",
+                         std::string("rows of `points` joined by each straight piece"));
 }
 
 // /xdmf/polyvertex_N for N = rows.total: 0, 1, ..., N - 1, each rank writing its rows.
@@ -441,6 +561,7 @@ void SnapshotWriter::write_polyvertex(const h5::RowRange& rows) {
 void SnapshotWriter::drop_and_read(double last_time) {
   if (!file_->link_exists(kSnapshotsGroup))
     throw IoError(fmt::format("{}: cannot resume: no {} group", h5_path_, kSnapshotsGroup));
+  material_names_ = file_->read_strings("/materials/name");
   if (file_->link_exists(kStagingGroup)) {
     for (const std::string& m : file_->group_members(kStagingGroup))
       file_->remove_link(kStagingGroup + "/" + m);
@@ -448,6 +569,7 @@ void SnapshotWriter::drop_and_read(double last_time) {
     file_->create_group(kStagingGroup);
   }
   if (!file_->link_exists(kXdmfGroup)) file_->create_group(kXdmfGroup);
+  if (!file_->link_exists(kWallsGroup)) file_->create_group(kWallsGroup);  // an older file
   std::vector<std::pair<std::uint64_t, std::string>> groups;
   for (const std::string& name : file_->group_members(kSnapshotsGroup)) {
     const std::optional<std::uint64_t> index = snapshot_index(name);
@@ -467,6 +589,7 @@ void SnapshotWriter::drop_and_read(double last_time) {
     next_index_ = index + 1;
   }
   reconcile_polyvertex();
+  reconcile_walls();
 }
 
 // The snapshot /snapshots/NAME as the file holds it; std::nullopt when its time is after
@@ -495,6 +618,32 @@ std::optional<SnapshotInfo> SnapshotWriter::read_record(const std::string& name,
         fmt::format("{}: cannot resume: '{}' has no {} dataset", h5_path_, group, kGeometry));
   r.particles = *rows;
   return r;
+}
+
+// resume(): records the wall outline of every kept snapshot that has one and removes the
+// others (those of dropped snapshots, or left by a write that failed between its moves).
+void SnapshotWriter::reconcile_walls() {
+  std::map<std::string, SnapshotInfo*> kept;
+  for (SnapshotInfo& r : records_) kept[r.name] = &r;
+  for (const std::string& member : file_->group_members(kWallsGroup)) {
+    const std::string group = kWallsGroup + "/" + member;
+    const auto it = kept.find(member);
+    if (it == kept.end()) {
+      file_->remove_link(group);
+      continue;
+    }
+    const bool complete =
+        file_->link_exists(group + "/points") && file_->link_exists(group + "/segments");
+    const h5::ParallelFile::DatasetShape points =
+        complete ? file_->dataset_shape(group + "/points") : h5::ParallelFile::DatasetShape{};
+    const h5::ParallelFile::DatasetShape segments =
+        complete ? file_->dataset_shape(group + "/segments") : h5::ParallelFile::DatasetShape{};
+    if (!complete || points.type != "double" || points.columns != 2 || segments.type != "int64" ||
+        segments.columns != 2 || segments.rows == 0)
+      throw IoError(fmt::format("{}: cannot resume: '{}' is not a wall outline", h5_path_, group));
+    it->second->wall_points = points.rows;
+    it->second->wall_segments = segments.rows;
+  }
 }
 
 // resume(): keeps the /xdmf/polyvertex_N the kept snapshots use (an unused one may be what a
@@ -539,8 +688,8 @@ std::string SnapshotWriter::rewrite_xdmf() {
     return ec ? fmt::format("cannot remove {}: {}", xdmf_path_, ec.message()) : std::string();
   }
   const std::string h5 = fs::path(h5_path_).filename().string();
-  std::string text(kXdmfHeader);
-  for (const SnapshotInfo& r : records_) text += xdmf_grid(h5, r);
+  std::string text = xdmf_header(material_names_);
+  for (const SnapshotInfo& r : records_) text += xdmf_grid(h5, r, material_names_);
   const auto trailer_at = static_cast<long>(text.size());
   text += kXdmfTrailer;
   std::string error = write_file_atomically(xdmf_path_, text);
@@ -556,7 +705,8 @@ std::string SnapshotWriter::append_xdmf(const SnapshotInfo& record) {
   if (fd < 0) return rewrite_xdmf();  // removed meanwhile: made anew
   const auto at = static_cast<off_t>(*xmf_trailer_);
   xmf_trailer_.reset();  // until the write succeeded
-  const std::string grid = xdmf_grid(fs::path(h5_path_).filename().string(), record);
+  const std::string grid =
+      xdmf_grid(fs::path(h5_path_).filename().string(), record, material_names_);
   bool ok = write_at(fd, grid + std::string(kXdmfTrailer), at);
   int error = errno;
   if (!ok && write_at(fd, kXdmfTrailer, at))

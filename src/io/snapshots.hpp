@@ -10,29 +10,40 @@
 //       one dataset per particle field marked `snapshot` in the store's registry
 //       (core/particles.hpp: id, material, position, velocity, angle, spin, radius), named as
 //       the field, N rows (N x 2 for a Vec2), with string attributes `unit` and `doc` from the
-//       field's FieldMeta; then any extra fields. The group tracks the creation order of its
-//       datasets (resume() reads them back in that order).
-//   /incomplete/NNNNNN                   the snapshot being written (staging); empty between
-//                                        writes, except after a failed write
+//       field's FieldMeta (`material` also `names`, "0=steel,1=ore"); then `speed` (|velocity|,
+//       m/s); then any extra fields. The group tracks the creation order of its datasets
+//       (resume() reads them back in that order). Only per-particle datasets: post/*.py and
+//       the tests read every member as N rows.
+//   /walls/NNNNNN                        the wall outline at snapshot NNNNNN's time, when write()
+//                                        was given one: attributes time, step;
+//       points   (M x 2 double, m)       the outline's points in the lab frame
+//       segments (S x 2 int64)           the straight pieces, as pairs of rows of `points`
+//   /incomplete/NNNNNN, /incomplete/walls_NNNNNN
+//                                        the snapshot being written and its outline (staging);
+//                                        empty between writes, except after a failed write
 //   /xdmf/polyvertex_N                   int64 0..N-1, the connectivity snapshots.xmf uses for
 //                                        its Polyvertex topology (one per particle count N)
 // N is the global number of owned particles; rank 0's particles come first, then rank 1's...
 //
-// Complete or absent. write() builds the snapshot in /incomplete/NNNNNN, flushes the file,
-// then moves the group's link to /snapshots/NNNNNN (H5Lmove: no data is copied) and flushes
-// again. A write that fails part-way (disk full) leaves at most a partial group under
-// /incomplete, never under /snapshots: everything under /snapshots is a complete snapshot.
-// Readers (post/*.py) list /snapshots only.
+// Complete or absent. write() builds the snapshot in /incomplete/NNNNNN and its outline in
+// /incomplete/walls_NNNNNN, flushes the file, then moves the outline's link to /walls/NNNNNN
+// and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and flushes again. A
+// write that fails part-way (disk full) leaves at most partial groups under /incomplete, never
+// under /snapshots: everything under /snapshots is a complete snapshot. Readers (post/*.py)
+// list /snapshots only.
 //
-// snapshots.xmf (XDMF 3): a temporal collection with one Polyvertex grid per snapshot, XY
-// geometry from position, and every other dataset as a point attribute (a Vec2 field, e.g.
-// velocity, as a 2-component Vector). Checked with ParaView 5.11's "XDMF Reader" and
-// "Xdmf3 Reader S/T". It lists exactly the snapshots under /snapshots, and only after they are
-// there. Rank 0 creates it whole with the first snapshot (through a temporary file and a
-// rename); each later snapshot costs O(1): its <Grid> and the fixed closing trailer
-// (</Grid></Domain></Xdmf>) overwrite the old trailer in place, so the file is a valid XDMF
-// document at every moment but during that one small write. resume() regenerates it whole
-// (temporary file and rename).
+// snapshots.xmf (XDMF 3): a temporal collection with, per snapshot, a spatial collection at its
+// time of two grids: "particles", a Polyvertex grid with XY geometry from position, every
+// other dataset as a point attribute (a Vec2 field, e.g. velocity, as a 2-component Vector) and
+// one field-data value "material: NAME" (its row) per material; and "walls", the outline as a
+// Polyline grid of 2-node segments (absent when the snapshot has none). The domain's
+// <Information Name="material_names" Value="0=steel,1=ore"/> names the materials too. Checked
+// with ParaView 5.11's "XDMF Reader" and "Xdmf3 Reader S/T". It lists exactly the snapshots
+// under /snapshots, and only after they are there. Rank 0 creates it whole with the first
+// snapshot (through a temporary file and a rename); each later snapshot costs O(1): its <Grid>
+// and the fixed closing trailer (</Grid></Domain></Xdmf>) overwrite the old trailer in place,
+// so the file is a valid XDMF document at every moment but during that one small write.
+// resume() regenerates it whole (temporary file and rename).
 //
 // Every member is collective over the communicator. A failure throws IoError with the same
 // message on every rank.
@@ -49,6 +60,7 @@
 
 #include "core/particles.hpp"
 #include "core/scene.hpp"
+#include "core/vec2.hpp"
 #include "io/hdf5.hpp"
 #include "parallel/comm.hpp"
 
@@ -74,7 +86,8 @@ struct SnapshotDataset {
 };
 
 // The datasets every snapshot of `particles` holds: the registry's fields marked `snapshot`,
-// in registry order. Throws std::logic_error for a marked field of a type it cannot write.
+// in registry order, then the derived `speed`. Throws std::logic_error for a marked field of a
+// type it cannot write.
 std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles);
 
 // What the writer knows of one snapshot of the file.
@@ -83,7 +96,9 @@ struct SnapshotInfo {
   double time = 0.0;
   std::int64_t step = 0;
   std::uint64_t particles = 0;            // N, all ranks
-  std::vector<SnapshotDataset> datasets;  // in the group's order: registry fields, then extras
+  std::vector<SnapshotDataset> datasets;  // in the group's order: registry fields, speed, extras
+  std::uint64_t wall_points = 0;          // M: rows of /walls/NNNNNN/points
+  std::uint64_t wall_segments = 0;        // S: rows of /walls/NNNNNN/segments; 0: no outline
 };
 
 class SnapshotWriter {
@@ -96,15 +111,16 @@ class SnapshotWriter {
 
   // Continues the snapshots of an interrupted run, for a restart from a checkpoint at `time`.
   // When DIR/snapshots.h5 exists, opens it read-write (MPI-IO, collectively), keeps its
-  // /materials (`materials` is not used), deletes every /snapshots group whose `time`
-  // attribute is > time + tolerance (the interrupted run wrote it after the checkpoint) and
-  // every staging group under /incomplete, and the /xdmf/polyvertex_N no kept snapshot uses;
-  // keeps the rest, numbers the next snapshot after the highest kept one, regenerates
-  // snapshots.xmf (temporary file and rename) to list exactly the kept snapshots (removes it
-  // when none is kept), and appends in O(1) from there. When DIR/snapshots.h5 does not exist,
-  // it is the constructor above. Throws IoError on every rank, with the same message naming
-  // the file, when the file cannot be opened ("cannot open DIR/snapshots.h5: REASON") or is
-  // not a snapshot file ("DIR/snapshots.h5: cannot ...").
+  // /materials (`materials` is not used: snapshots.xmf names the file's /materials/name),
+  // deletes every /snapshots group whose `time` attribute is > time + tolerance (the
+  // interrupted run wrote it after the checkpoint), every staging group under /incomplete, the
+  // /xdmf/polyvertex_N no kept snapshot uses and the /walls/NNNNNN of no kept snapshot; keeps
+  // the rest, numbers the next snapshot after the highest kept one, regenerates snapshots.xmf
+  // (temporary file and rename) to list exactly the kept snapshots (removes it when none is
+  // kept), and appends in O(1) from there. When DIR/snapshots.h5 does not exist, it is the
+  // constructor above. Throws IoError on every rank, with the same message naming the file,
+  // when the file cannot be opened ("cannot open DIR/snapshots.h5: REASON") or is not a
+  // snapshot file ("DIR/snapshots.h5: cannot ...").
   static std::unique_ptr<SnapshotWriter> resume(MPI_Comm comm, const std::string& directory,
                                                 const std::vector<MaterialSpec>& materials,
                                                 double time, double tolerance);
@@ -113,12 +129,15 @@ class SnapshotWriter {
   SnapshotWriter(const SnapshotWriter&) = delete;
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
 
-  // Writes the owned particles [0, n_owned()) as the next snapshot: /incomplete/NNNNNN,
-  // flush, move to /snapshots/NNNNNN, flush; then rank 0 appends its grid to snapshots.xmf.
-  // After a failed write (IoError) the writer may write again: the next write first removes
-  // what the failed one left and reuses its number if it did not reach /snapshots.
+  // Writes the owned particles [0, n_owned()) as the next snapshot, with the wall outline
+  // `walls` (polylines in the lab frame at `time`, e.g. core/walls.hpp's wall_outlines; rank
+  // 0's are written, every rank passes the same; none: no /walls group, no "walls" grid):
+  // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, flush, move to /walls/NNNNNN and
+  // /snapshots/NNNNNN, flush; then rank 0 appends its grid to snapshots.xmf. After a failed
+  // write (IoError) the writer may write again: the next write first removes what the failed
+  // one left and reuses its number if it did not reach /snapshots.
   void write(const ParticleStore& particles, double time, std::int64_t step,
-             std::span<const ExtraField> extra = {});
+             std::span<const std::vector<Vec2>> walls = {}, std::span<const ExtraField> extra = {});
 
   // Closes the file and reports a failure (the destructor cannot). Later writes are errors.
   void close();
@@ -131,27 +150,32 @@ class SnapshotWriter {
 
   // Testing only (tests/io): the next write() throws IoError on every rank, as a full disk
   // would, just before it writes dataset number `datasets` (0: the first) of its staging
-  // group, or, when the snapshot has no more datasets than that, after the last one (before
-  // the flush and the move); the message ends in "injected failure". It costs a write nothing
-  // when not armed. Collective: call it on every rank.
+  // group (snapshot_datasets, then the extra fields), or, when the snapshot has no more
+  // datasets than that, after the last one and the wall outline (before the flush and the
+  // moves); the message ends in "injected failure". It costs a write nothing when not armed.
+  // Collective: call it on every rank.
   void fail_before_dataset_for_testing(std::size_t datasets) { fail_before_dataset_ = datasets; }
 
  private:
   struct NoFile {};  // the constructors' common part: the paths, no file opened yet
+  struct WallData;   // an outline as written: points and segments
+  static WallData wall_data(std::span<const std::vector<Vec2>> outlines);
   SnapshotWriter(NoFile, MPI_Comm comm, const std::string& directory);
   SnapshotInfo describe(const ParticleStore& p, double time, std::int64_t step,
                         std::span<const ExtraField> extra) const;
   void write_materials(const std::vector<MaterialSpec>& materials);
   void clear_failed_write(const std::string& name);
   void stage(const std::string& group, const SnapshotInfo& record, const h5::RowRange& rows,
-             const ParticleStore& p, std::span<const ExtraField> extra);
+             const ParticleStore& p, std::span<const ExtraField> extra, const WallData& walls);
   void write_datasets(const std::string& group, const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
   void write_polyvertex(const h5::RowRange& rows);
+  void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
   void agree(const std::string& local_error);  // IoError on every rank if any failed
   void drop_and_read(double last_time);        // resume: the file's part
   std::optional<SnapshotInfo> read_record(const std::string& name, double last_time);
   void reconcile_polyvertex();
+  void reconcile_walls();
   // Rank 0; each returns an error message, empty on success.
   std::string rewrite_xdmf();                           // the whole file, atomically
   std::string append_xdmf(const SnapshotInfo& record);  // in place, O(1)
@@ -161,6 +185,7 @@ class SnapshotWriter {
   std::string h5_path_;
   std::string xdmf_path_;
   std::optional<h5::ParallelFile> file_;
+  std::vector<std::string> material_names_;  // /materials/name: snapshots.xmf names them
   std::vector<SnapshotInfo> records_;
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written

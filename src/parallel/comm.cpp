@@ -40,6 +40,12 @@ void sum_in_place(MPI_Comm comm, std::span<double> values) {
                 comm);
 }
 
+void sum_in_place(MPI_Comm comm, std::span<std::int64_t> values) {
+  if (values.empty()) return;
+  MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_INT64_T, MPI_SUM,
+                comm);
+}
+
 double max(MPI_Comm comm, double x) {
   double r = 0.0;
   MPI_Allreduce(&x, &r, 1, MPI_DOUBLE, MPI_MAX, comm);

@@ -34,6 +34,7 @@ std::uint64_t sum(MPI_Comm comm, std::uint64_t x);
 std::uint64_t exclusive_scan_sum(MPI_Comm comm, std::uint64_t x);
 // Element-wise sum in place. Exact only when every partial sum is (e.g. multiples of 1/2).
 void sum_in_place(MPI_Comm comm, std::span<double> values);
+void sum_in_place(MPI_Comm comm, std::span<std::int64_t> values);
 // Maximum, element-wise maximum in place, logical or: exact.
 double max(MPI_Comm comm, double x);
 void max_in_place(MPI_Comm comm, std::span<double> values);

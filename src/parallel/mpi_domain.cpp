@@ -67,6 +67,14 @@ void MpiDomain::max(std::span<double> values) const {
   if (size_ > 1) mpi::max_in_place(comm_, values);
 }
 
+void MpiDomain::sum(std::span<std::int64_t> values) const {
+  if (size_ > 1) mpi::sum_in_place(comm_, values);
+}
+
+void MpiDomain::sum(std::span<double> values) const {
+  if (size_ > 1) mpi::sum_in_place(comm_, values);
+}
+
 std::vector<std::int64_t> MpiDomain::allgather(std::span<const std::int64_t> mine) const {
   if (size_ == 1) return {mine.begin(), mine.end()};
   return mpi::all_gather(comm_, mine);

@@ -109,6 +109,8 @@ class MpiDomain final : public Domain {
   std::int64_t sum(std::int64_t x) const override;
   bool any(bool x) const override;
   void max(std::span<double> values) const override;
+  void sum(std::span<std::int64_t> values) const override;
+  void sum(std::span<double> values) const override;
   std::vector<std::int64_t> allgather(std::span<const std::int64_t> mine) const override;
   bool owns(Vec2 x) const override { return owner_of(x) == rank_; }
   void population_changed(std::int64_t total) override { total_particles_ = total; }

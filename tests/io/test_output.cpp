@@ -275,6 +275,8 @@ void check_snapshot(hid_t file, const std::string& name, int n, int version, dou
   EXPECT_EQ(dims, (Dims{un}));
   const auto angle = read_dataset<double>(file, g + "/angle", H5T_NATIVE_DOUBLE, dims);
   EXPECT_EQ(dims, (Dims{un}));
+  const auto speed = read_dataset<double>(file, g + "/speed", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un}));
   ASSERT_EQ(id.size(), un);
   ASSERT_EQ(angle.size(), un);
   ASSERT_EQ(pos.size(), 2 * un);
@@ -282,6 +284,7 @@ void check_snapshot(hid_t file, const std::string& name, int n, int version, dou
   ASSERT_EQ(spin.size(), un);
   ASSERT_EQ(radius.size(), un);
   ASSERT_EQ(material.size(), un);
+  ASSERT_EQ(speed.size(), un);
   for (int k = 0; k < n; ++k) {
     const Expected e = expected(k, version);
     const auto i = static_cast<std::size_t>(k);
@@ -294,6 +297,7 @@ void check_snapshot(hid_t file, const std::string& name, int n, int version, dou
     EXPECT_EQ(spin[i], e.spin) << "k=" << k;
     EXPECT_EQ(radius[i], e.radius) << "k=" << k;
     EXPECT_EQ(angle[i], e.angle) << "k=" << k;
+    EXPECT_EQ(speed[i], std::sqrt(e.vel.x * e.vel.x + e.vel.y * e.vel.y)) << "k=" << k;
   }
 }
 
@@ -323,6 +327,17 @@ std::string xml_problem(const std::string& text) {
     }
   }
   return open.empty() ? "" : "unclosed <" + open.back() + ">";
+}
+
+// Every value of `<Time Value="..."`: the times of the snapshots of a sidecar.
+std::vector<std::string> time_values(const std::string& text) {
+  std::vector<std::string> out;
+  const std::string key = "<Time Value=\"";
+  for (std::size_t i = 0; (i = text.find(key, i)) != std::string::npos;) {
+    i += key.size();
+    out.push_back(text.substr(i, text.find('"', i) - i));
+  }
+  return out;
 }
 
 // Every value of `attribute="..."` in `text`.
@@ -356,7 +371,7 @@ TEST(SnapshotWriter, TwoSnapshotsRoundTripExactly) {
     ParticleStore b;
     const std::vector<double> dmg = fill(b, n, 1, [&](int k) { return block_owner(k, n); });
     const ExtraField extra[] = {{"damage", dmg}};
-    writer.write(b, t1, 25000, extra);
+    writer.write(b, t1, 25000, {}, extra);
     EXPECT_EQ(writer.snapshots_written(), 2u);
   }
   MPI_Barrier(MPI_COMM_WORLD);
@@ -395,17 +410,20 @@ TEST(SnapshotWriter, TwoSnapshotsRoundTripExactly) {
   column("sliding_friction", &MaterialSpec::sliding_friction);
   column("rolling_friction", &MaterialSpec::rolling_friction);
 
-  // The XDMF sidecar: well formed, one Uniform grid per snapshot with its time, every
-  // heavy-data path present in the HDF5 file.
+  // The XDMF sidecar: well formed, one spatial collection per snapshot with its time holding
+  // the particles' Uniform grid (no outline given: no walls grid), every heavy-data path
+  // present in the HDF5 file.
   ASSERT_TRUE(fs::exists(dir / "snapshots.xmf"));
   EXPECT_FALSE(fs::exists(dir / "snapshots.xmf.tmp"));
   const std::string xmf = read_text(dir / "snapshots.xmf");
   EXPECT_EQ(xml_problem(xmf), "");
   EXPECT_NE(xmf.find("<Xdmf Version=\"3.0\""), std::string::npos);
-  EXPECT_EQ(count(xmf, "<Grid "), 3u);  // the temporal collection and two snapshots
+  EXPECT_EQ(count(xmf, "<Grid "), 5u);  // the temporal collection, two snapshots of one grid
   EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), 2u);
   EXPECT_EQ(count(xmf, "CollectionType=\"Temporal\""), 1u);
-  const auto times = attribute_values(xmf, "Value");
+  EXPECT_EQ(count(xmf, "CollectionType=\"Spatial\""), 2u);
+  EXPECT_EQ(count(xmf, "<Grid Name=\"walls\""), 0u);
+  const auto times = time_values(xmf);
   ASSERT_EQ(times.size(), 2u);
   EXPECT_EQ(std::strtod(times[0].c_str(), nullptr), t0);
   EXPECT_EQ(std::strtod(times[1].c_str(), nullptr), t1);
@@ -526,11 +544,13 @@ TEST(SnapshotWriter, EveryRegistryFieldMarkedForOutputIsWrittenWithItsUnit) {
   }
   EXPECT_TRUE(marked.contains("angle")) << "the rotation angle is state a user reads back";
   EXPECT_FALSE(marked.contains("force")) << "accumulators are not state";
-  EXPECT_EQ(group_members(file.id, "/snapshots/000000"), marked) << "nothing else is written";
+  std::set<std::string> datasets = marked;
+  datasets.insert("speed");  // derived, after the registry's
+  EXPECT_EQ(group_members(file.id, "/snapshots/000000"), datasets) << "nothing else is written";
   // snapshot_datasets() describes the same datasets, in registry order.
   std::set<std::string> described;
   for (const SnapshotDataset& d : snapshot_datasets(registry)) described.insert(d.name);
-  EXPECT_EQ(described, marked);
+  EXPECT_EQ(described, datasets);
 }
 
 // docs/output.md's table of snapshot datasets is the registry's, row for row (run the test
@@ -563,7 +583,10 @@ TEST(SnapshotWriter, ExtraFieldMayNotReuseARegistryName) {
   ParticleStore p;
   const std::vector<double> values = fill(p, 3, 0, [](int) { return 0; });
   const ExtraField clash[] = {{"angle", values}};
-  EXPECT_THROW(writer.write(p, 0.0, 0, clash), std::invalid_argument);
+  EXPECT_THROW(writer.write(p, 0.0, 0, {}, clash), std::invalid_argument);
+  const std::vector<double> zeros(values.size(), 0.0);
+  const ExtraField derived[] = {{"speed", zeros}};
+  EXPECT_THROW(writer.write(p, 0.0, 0, {}, derived), std::invalid_argument);
 }
 
 void expect_same_io_error_everywhere(const std::function<void()>& f, const std::string& prefix) {
@@ -602,13 +625,25 @@ TEST(SnapshotWriter, UnwritableDirectoryFailsOnEveryRank) {
 
 const std::string kXdmfTrailer = "    </Grid>\n  </Domain>\n</Xdmf>\n";
 
+// A wall outline for snapshot `version`: a closed square turned by the version (4 points, 4
+// segments) and an open 3-point polyline (3 points, 2 segments), values not round in binary.
+std::vector<std::vector<Vec2>> outline(int version) {
+  const double a = 0.1 * version + 1.0 / 3.0;
+  const Vec2 c{std::cos(a), std::sin(a)};
+  const std::vector<Vec2> square{c, {-c.y, c.x}, {-c.x, -c.y}, {c.y, -c.x}, c};
+  const std::vector<Vec2> open{{0.1, -1.0 / 7.0}, {0.2, -0.5 + version}, {0.3, -1.0 / 7.0}};
+  return {square, open};
+}
+
 // Writes particles [0, n) of `version`, in blocks over the ranks, at `time` (step 1000 x
-// version), with the extra field `damage` when asked.
-void write_version(SnapshotWriter& w, int n, int version, double time, bool with_damage = false) {
+// version), with the extra field `damage` and the outline(version) when asked.
+void write_version(SnapshotWriter& w, int n, int version, double time, bool with_damage = false,
+                   bool with_walls = false) {
   ParticleStore p;
   const std::vector<double> dmg = fill(p, n, version, [n](int k) { return block_owner(k, n); });
   const ExtraField extra[] = {{"damage", dmg}};
-  w.write(p, time, 1000 * version,
+  const auto walls = with_walls ? outline(version) : std::vector<std::vector<Vec2>>{};
+  w.write(p, time, 1000 * version, walls,
           with_damage ? std::span<const ExtraField>(extra) : std::span<const ExtraField>());
 }
 
@@ -620,8 +655,7 @@ std::uint64_t inode(const std::string& path) {
 // The `Time Value`s of a sidecar, as numbers.
 std::vector<double> xdmf_times(const std::string& xmf) {
   std::vector<double> out;
-  for (const std::string& v : attribute_values(xmf, "Value"))
-    out.push_back(std::strtod(v.c_str(), nullptr));
+  for (const std::string& v : time_values(xmf)) out.push_back(std::strtod(v.c_str(), nullptr));
   return out;
 }
 
@@ -691,6 +725,126 @@ TEST(SnapshotWriter, AWriteAfterAFailedOneTakesItsNumber) {
   EXPECT_EQ(xdmf_times(xmf), (std::vector<double>{0.1, 0.3}));
 }
 
+// /walls/NAME against outline(version): the square's 4 points (closed: its last segment back
+// to its first point), the open polyline's 3; time and step as the snapshot's.
+void check_outline(hid_t file, const std::string& name, int version, double time,
+                   std::int64_t step) {
+  SCOPED_TRACE("outline " + name);
+  const std::string g = "/walls/" + name;
+  EXPECT_EQ(read_attribute<double>(file, g, "time", H5T_NATIVE_DOUBLE), time);
+  EXPECT_EQ(read_attribute<std::int64_t>(file, g, "step", H5T_NATIVE_INT64), step);
+  EXPECT_EQ(read_string_attribute(file, g + "/points", "unit"), "m");
+  Dims dims;
+  const auto points = read_dataset<double>(file, g + "/points", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{7, 2}));
+  std::vector<double> expected;
+  const auto lines = outline(version);
+  for (std::size_t k = 0; k < 4; ++k)
+    expected.insert(expected.end(), {lines[0][k].x, lines[0][k].y});
+  for (const Vec2 q : lines[1]) expected.insert(expected.end(), {q.x, q.y});
+  EXPECT_EQ(points, expected);
+  const auto segments = read_dataset<std::int64_t>(file, g + "/segments", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{6, 2}));
+  EXPECT_EQ(segments, (std::vector<std::int64_t>{0, 1, 1, 2, 2, 3, 3, 0, 4, 5, 5, 6}));
+}
+
+// The outline given to write() goes to /walls/NNNNNN (rank 0's), the sidecar draws it as a
+// Polyline grid beside the particles; a snapshot without one has neither. Every snapshot names
+// the materials: the `names` attribute of its material rows, and the sidecar's Information and
+// field data.
+TEST(SnapshotWriter, WallOutlineAndMaterialNamesAreWrittenWithTheSnapshot) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1, false, true);
+    write_version(writer, 4, 1, 0.2);
+    EXPECT_EQ(writer.snapshots()[0].wall_points, 7u);
+    EXPECT_EQ(writer.snapshots()[0].wall_segments, 6u);
+    EXPECT_EQ(writer.snapshots()[1].wall_segments, 0u);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  check_snapshot(file.id, "000000", 5, 0, 0.1, 0);
+  check_snapshot(file.id, "000001", 4, 1, 0.2, 1000);
+  EXPECT_EQ(group_members(file.id, "/walls"), (std::set<std::string>{"000000"}));
+  EXPECT_EQ(group_members(file.id, "/walls/000000"), (std::set<std::string>{"points", "segments"}));
+  check_outline(file.id, "000000", 0, 0.1, 0);
+  for (const char* name : {"000000", "000001"})
+    EXPECT_EQ(
+        read_string_attribute(file.id, std::string("/snapshots/") + name + "/material", "names"),
+        "0=steel,1=iron ore,2=rubber-liner");
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_EQ(count(xmf,
+                  "<Information Name=\"material_names\" "
+                  "Value=\"0=steel,1=iron ore,2=rubber-liner\"/>"),
+            1u);
+  EXPECT_EQ(count(xmf,
+                  "<Attribute Name=\"material: rubber-liner\" AttributeType=\"Scalar\" "
+                  "Center=\"Grid\">"),
+            2u);
+  EXPECT_EQ(count(xmf, "Format=\"XML\">2</DataItem>"), 2u);
+  EXPECT_EQ(count(xmf, "<Attribute Name=\"speed\" AttributeType=\"Scalar\" Center=\"Node\">"), 2u);
+  EXPECT_EQ(count(xmf, "<Grid Name=\"walls\" GridType=\"Uniform\">"), 1u);
+  EXPECT_EQ(count(xmf,
+                  "<Topology TopologyType=\"Polyline\" NumberOfElements=\"6\" "
+                  "NodesPerElement=\"2\">"),
+            1u);
+  EXPECT_EQ(count(xmf,
+                  "Dimensions=\"6 2\" NumberType=\"Int\" Precision=\"8\" "
+                  "Format=\"HDF\">snapshots.h5:/walls/000000/segments<"),
+            1u);
+  EXPECT_EQ(count(xmf,
+                  "Dimensions=\"7 2\" NumberType=\"Float\" Precision=\"8\" "
+                  "Format=\"HDF\">snapshots.h5:/walls/000000/points<"),
+            1u);
+  EXPECT_EQ(count(xmf, "/walls/000001"), 0u);
+}
+
+// A write that fails after staging its outline leaves it under /incomplete, never under /walls;
+// the next write clears it and publishes its own.
+TEST(SnapshotWriter, AFailedWritesOutlineStaysStagedAndTheNextWriteReplacesIt) {
+  const std::size_t datasets = snapshot_datasets(ParticleStore{}).size();
+  {
+    ScratchDir stopped;  // the run stops after the failed write
+    {
+      SnapshotWriter writer(MPI_COMM_WORLD, stopped.path(), test_materials());
+      write_version(writer, 5, 0, 0.1, false, true);
+      writer.fail_before_dataset_for_testing(datasets);  // after the outline, before the flush
+      EXPECT_THROW(write_version(writer, 5, 1, 0.2, false, true), IoError);
+      writer.close();
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (comm_rank() == 0) {
+      H5Closer f{H5Fopen((stopped / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT),
+                 H5Fclose};
+      ASSERT_GE(f.id, 0);
+      EXPECT_EQ(group_members(f.id, "/incomplete"),
+                (std::set<std::string>{"000001", "walls_000001"}));
+      EXPECT_EQ(group_members(f.id, "/walls"), (std::set<std::string>{"000000"}));
+      EXPECT_EQ(count(read_text(stopped / "snapshots.xmf"), "/walls/000001"), 0u);
+    }
+  }
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1, false, true);
+    writer.fail_before_dataset_for_testing(datasets);
+    EXPECT_THROW(write_version(writer, 5, 1, 0.2, false, true), IoError);
+    write_version(writer, 5, 2, 0.3, false, true);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  EXPECT_EQ(group_members(file.id, "/walls"), (std::set<std::string>{"000000", "000001"}));
+  check_outline(file.id, "000000", 0, 0.1, 0);
+  check_outline(file.id, "000001", 2, 0.3, 2000);
+}
+
 // Each snapshot appends its grid in place (the same file, the old text less its trailer kept
 // as it was), the sidecar is valid after every write, and after five appends it is, byte for
 // byte, the sidecar regenerated from the file's groups (resume() keeping them all).
@@ -703,13 +857,13 @@ TEST(SnapshotWriter, SidecarIsAppendedInPlaceAndEqualsTheRegeneratedOne) {
     SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
     std::uint64_t created = 0;
     for (int v = 0; v < 5; ++v) {
-      write_version(writer, counts[v], v, 0.1 * (v + 1), v == 3);
+      write_version(writer, counts[v], v, 0.1 * (v + 1), v == 3, v == 1 || v >= 3);
       if (comm_rank() != 0) continue;
       SCOPED_TRACE("after snapshot " + std::to_string(v));
       const std::string xmf = read_text(path);
       EXPECT_EQ(xml_problem(xmf), "");
       EXPECT_TRUE(xmf.ends_with(kXdmfTrailer));
-      EXPECT_EQ(count(xmf, "GridType=\"Uniform\""), static_cast<std::size_t>(v + 1));
+      EXPECT_EQ(count(xmf, "<Grid Name=\"particles\""), static_cast<std::size_t>(v + 1));
       if (v == 0) {
         created = inode(path);
       } else {
@@ -731,6 +885,8 @@ TEST(SnapshotWriter, SidecarIsAppendedInPlaceAndEqualsTheRegeneratedOne) {
   EXPECT_EQ(xdmf_times(regenerated), (std::vector<double>{0.1, 0.2, 0.1 * 3, 0.4, 0.5}));
   EXPECT_EQ(count(regenerated, "Name=\"damage\""), 1u);
   EXPECT_EQ(count(regenerated, "NumberOfElements=\"0\""), 1u);
+  EXPECT_EQ(count(regenerated, "<Grid Name=\"walls\""), 3u);
+  EXPECT_EQ(count(regenerated, "Name=\"material: iron ore\""), 5u);
 }
 
 // A restart from a checkpoint at t = 0.3: the snapshots the interrupted run wrote after it
@@ -742,11 +898,11 @@ TEST(SnapshotWriter, ResumeDropsTheSnapshotsAfterTheCheckpointAndContinues) {
   {
     SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
     for (int v = 0; v < 5; ++v) {
-      write_version(writer, v < 3 ? 5 : 6, v, 0.1 * (v + 1));
+      write_version(writer, v < 3 ? 5 : 6, v, 0.1 * (v + 1), false, true);
       if (v == 2 && comm_rank() == 0) at_checkpoint = read_text(dir / "snapshots.xmf");
     }
     writer.fail_before_dataset_for_testing(2);  // interrupted: /incomplete/000005 is left
-    EXPECT_THROW(write_version(writer, 6, 5, 0.6), IoError);
+    EXPECT_THROW(write_version(writer, 6, 5, 0.6, false, true), IoError);
   }
   MPI_Barrier(MPI_COMM_WORLD);
   {
@@ -760,7 +916,9 @@ TEST(SnapshotWriter, ResumeDropsTheSnapshotsAfterTheCheckpointAndContinues) {
     if (comm_rank() == 0) {
       EXPECT_EQ(read_text(dir / "snapshots.xmf"), at_checkpoint);
     }
-    write_version(*writer, 5, 9, 0.35);
+    EXPECT_EQ(writer->snapshots().back().wall_points, 7u);
+    EXPECT_EQ(writer->snapshots().back().wall_segments, 6u);
+    write_version(*writer, 5, 9, 0.35, false, true);
     EXPECT_EQ(writer->snapshots().back().name, "000003");
     writer->close();
   }
@@ -774,6 +932,11 @@ TEST(SnapshotWriter, ResumeDropsTheSnapshotsAfterTheCheckpointAndContinues) {
     check_snapshot(file.id, "00000" + std::to_string(v), 5, v, 0.1 * (v + 1), 1000 * v);
   check_snapshot(file.id, "000003", 5, 9, 0.35, 9000);
   EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  // The dropped snapshots' outlines are gone with them.
+  EXPECT_EQ(group_members(file.id, "/walls"),
+            (std::set<std::string>{"000000", "000001", "000002", "000003"}));
+  check_outline(file.id, "000002", 2, 0.1 * 3, 2000);
+  check_outline(file.id, "000003", 9, 0.35, 9000);
   // The dropped snapshots' connectivity is gone with them.
   EXPECT_EQ(group_members(file.id, "/xdmf"), (std::set<std::string>{"polyvertex_5"}));
   const std::string xmf = read_text(dir / "snapshots.xmf");
@@ -845,6 +1008,43 @@ TEST(SnapshotWriter, SidecarFailureIsReportedAndTheNextWriteRewritesIt) {
   const std::string text = read_text(xmf);
   EXPECT_EQ(xml_problem(text), "");
   EXPECT_EQ(xdmf_times(text), (std::vector<double>{0.1, 0.2, 0.3}));
+}
+
+// snapshots.xmf checked against snapshots.h5 by tests/io/check_xdmf.py (python3 with
+// xml.etree and h5py): every DataItem names a dataset of the file with the stated Dimensions,
+// NumberType and Precision; topologies, geometries and attributes agree in size; the grids are
+// exactly the file's snapshots and outlines; the material names are the file's. Checked after
+// appends (with and without an outline, no particles, an extra field), and after a resume
+// regenerated the sidecar and appended to it.
+TEST(XdmfSidecar, EveryDataItemMatchesTheHdf5File) {
+  ScratchDir dir;
+  const auto check = [&](const std::string& when) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (comm_rank() != 0) return;
+    const std::string log = dir / "check_xdmf.log";
+    const std::string command = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) +
+                                "/tests/io/check_xdmf.py' '" + (dir / "snapshots.xmf") + "' > '" +
+                                log + "' 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << when << ":\n" << read_text(log);
+  };
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1, false, true);
+    write_version(writer, 0, 1, 0.2, false, true);
+    write_version(writer, 6, 2, 0.3, true, false);
+    write_version(writer, 6, 3, 0.4, true, true);
+  }
+  check("after four snapshots");
+  {
+    const auto writer = SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 0.35, 1e-9);
+    write_version(*writer, 7, 4, 0.5, false, true);
+  }
+  check("after a resume and one more snapshot");
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), {});  // no materials
+    write_version(writer, 3, 0, 0.0, false, true);
+  }
+  check("without materials");
 }
 
 TEST(ParallelFile, ErrorsNameTheFileAndTheObject) {

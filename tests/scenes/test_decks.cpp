@@ -2,7 +2,10 @@
 // and run (shortened where noted) with the physics checked against closed form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iostream>
+#include <map>
 #include <numbers>
 #include <string>
 
@@ -90,9 +93,12 @@ TEST(Decks, InclineRollsAtFiveSeventhsWithRollingFriction) {
 
 // The thesis decks: --check numbers of the waterfall deck (fill fraction 240 pi 0.1^2 / pi 2.5^2).
 TEST(Decks, ThesisDecksResolveTableOneValues) {
-  for (const char* name : {"cascade.in", "cascade_cataract.in", "waterfall.in", "centrifuge.in"}) {
+  for (const char* name : {"cascade.in", "cascade_cataract.in", "waterfall.in", "centrifuge.in",
+                           "waterfall_polygon.in"}) {
     const Scene s = deck(name);
-    ASSERT_EQ(s.materials.size(), 1u) << name;
+    ASSERT_GE(s.materials.size(), 1u) << name;
+    EXPECT_EQ(s.materials[0].name, "steel");
+    EXPECT_EQ(s.fills[0].material, "steel");
     EXPECT_DOUBLE_EQ(s.materials[0].youngs_modulus, 2e11);
     EXPECT_DOUBLE_EQ(s.materials[0].shear_modulus, 8e10);
     EXPECT_DOUBLE_EQ(s.materials[0].density, 7800);
@@ -106,6 +112,42 @@ TEST(Decks, ThesisDecksResolveTableOneValues) {
   const Scene w = deck("waterfall.in");
   EXPECT_EQ(w.fills[0].count, 240);
   EXPECT_DOUBLE_EQ(w.drum.speed, 1.8);
+  // The liners that give each deck its regime (the deck headers, docs/validation.md).
+  EXPECT_EQ(w.drum.lifters.at(0).count, 24);
+  EXPECT_EQ(deck("cascade.in").drum.lifters.at(0).count, 16);
+  const Scene mixed = deck("cascade_cataract.in");
+  EXPECT_EQ(mixed.drum.material, "liner");
+  EXPECT_DOUBLE_EQ(mixed.materials.at(1).sliding_friction, 0.4);
+  EXPECT_EQ(deck("waterfall_polygon.in").drum.sides, 16);
+}
+
+// The regime classifier (core/mill_analytics.hpp) on the shipped regime decks, run whole (10 s,
+// a series row every 1 ms as the decks write them): over the last 5 s the regime of most rows
+// is the one the deck's name says, and so is the run's (the last window's).
+TEST(Decks, RegimeDecksAreClassifiedAsTheirNamesSay) {
+  const std::pair<const char*, Regime> cases[] = {{"cascade.in", Regime::kCascading},
+                                                  {"cascade_cataract.in", Regime::kMixed},
+                                                  {"waterfall.in", Regime::kCataracting},
+                                                  {"centrifuge.in", Regime::kCentrifuging}};
+  for (const auto& [name, expected] : cases) {
+    Simulation sim(deck(name));
+    std::map<std::string, int> rows;
+    while (sim.time() + 0.5 * sim.dt() < sim.scene().run.duration) {
+      sim.run_until(sim.time() + sim.scene().output.series_interval);
+      const SeriesRow row = sim.record_row();
+      if (row.time > 5.0) ++rows[row.regime];
+    }
+    const auto most = std::max_element(
+        rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
+    int total = 0;
+    for (const auto& [regime, count] : rows) total += count;
+    std::cout << "[ regime ] " << name << ": " << most->first << " in " << most->second << " of "
+              << total << " rows over 5-10 s; the run: " << regime_name(sim.mill_summary().regime)
+              << "\n";
+    EXPECT_EQ(most->first, regime_name(expected)) << name;
+    EXPECT_GT(most->second, total / 2) << name;
+    EXPECT_EQ(sim.mill_summary().regime, expected) << name;
+  }
 }
 
 // lifters.in: the lifters carry the charge up; the same smooth shell without them lets it slip.

@@ -1,0 +1,93 @@
+#!/bin/bash
+# The mill's variables and analytics through the command line:
+#   - --set of one speed key replaces the deck's other one (speed, speed_rpm,
+#     critical_fraction), a fill's count gives way to a fill fraction; two alternatives both set
+#     on the command line are refused;
+#   - --check prints the critical speeds, the fraction of critical, the bed filling J and the
+#     2D-to-3D slice thickness; run.json's "mill" object holds them with the regime;
+#   - the collision spectra (collisions.csv) count the same contacts on 1 and 3 ranks, and a
+#     run resumed from a checkpoint on another rank count ends with the same spectra.
+#
+#   tests/cli/mill_tests.sh DEM2D SOURCE_DIR
+set -u
+dem2d=$1
+src=$2
+py=/usr/bin/python3
+# shellcheck source=tests/cli/lib.sh
+source "$(dirname "$0")/lib.sh"
+# Ranks waiting for each other yield the core instead of spinning (the suite runs tests side by
+# side on 2 cores).
+export OMPI_MCA_mpi_yield_when_idle=1
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/dem2d_mill.XXXXXX")
+trap 'rm -rf "$tmp"' EXIT
+wf=$src/inputs/waterfall.in
+
+# --set in the engineer's variables (waterfall: R = 2.5 m, g = 9.81: critical 1.9809 rad/s).
+expect "critical_fraction replaces speed" 0 'drum speed: +1\.3866 rad/s = 0\.700 of critical' -- \
+  "$dem2d" --check --set drum.critical_fraction=0.7 "$wf"
+expect "speed_rpm replaces speed" 0 'drum speed: +1\.0472 rad/s = 0\.529 of critical' -- \
+  "$dem2d" --check --set drum.speed_rpm=10 "$wf"
+expect "fill_fraction replaces count" 0 'fill fraction: +0\.30' -- \
+  "$dem2d" --check --set fill.0.fill_fraction=0.3 "$wf"
+expect "two speeds on the command line" 2 'give only one of speed, speed_rpm and critical_fraction' -- \
+  "$dem2d" --check --set drum.speed_rpm=10 --set drum.critical_fraction=0.7 "$wf"
+expect "two speeds on 2 ranks" 2 'give only one of speed, speed_rpm and critical_fraction' -- \
+  mpirun -np 2 --oversubscribe "$dem2d" --check --set drum.speed_rpm=10 --set drum.critical_fraction=0.7 "$wf"
+
+# --check's mill numbers: 240 balls of 0.1 m in 2.5 m: phi = 0.384, J = 0.384 / 0.84, T37
+# (1 - 0.384)^(-1/4) sqrt(9.81 / 2.5) = 2.2360 rad/s, slice 0.2 m.
+expect "check bed filling" 0 'bed filling J: +0\.457' -- "$dem2d" --check "$wf"
+expect "check T37" 0 'with fill \(thesis T37\) 2\.2360 rad/s' -- "$dem2d" --check "$wf"
+expect "check slice" 0 '2D to 3D: +the slice is 0\.2 m thick' -- "$dem2d" --check "$wf"
+
+# A short run with spectra on 1 and 3 ranks, and one resumed 1 -> 2 from a checkpoint at 0.3 s.
+run=(--quiet --set run.duration=0.3 --set output.collision_spectra=true --set output.snapshot_interval=0.1
+  --set output.analysis_window=0.2)
+"$dem2d" "$wf" "${run[@]}" --output "$tmp/np1" > "$tmp/np1.log" 2>&1 || fail "np1 run: $(cat "$tmp/np1.log")"
+mpirun -np 3 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$tmp/np3" > "$tmp/np3.log" 2>&1 ||
+  fail "np3 run: $(cat "$tmp/np3.log")"
+"$dem2d" "$wf" "${run[@]}" --set run.duration=0.15 --output "$tmp/rs" > "$tmp/rs.log" 2>&1 ||
+  fail "first half: $(cat "$tmp/rs.log")"
+mpirun -np 2 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$tmp/rs" --restart "$tmp/rs/checkpoint.h5" \
+  > "$tmp/rs2.log" 2>&1 || fail "restart: $(cat "$tmp/rs2.log")"
+
+# same_spectra NAME A B: the same rows; counts and bins exactly, the energy sums to 1e-12.
+same_spectra() {
+  local out
+  if out=$("$py" - "$2/collisions.csv" "$3/collisions.csv" 2>&1 <<'EOF'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b) and len(a) > 10, f"{len(a)} rows vs {len(b)}"
+types = set()
+for x, y in zip(a, b):
+    for k in ("type", "size_min", "size_max", "energy_min", "energy_max", "count"):
+        assert x[k] == y[k], f"{k}: {x[k]} vs {y[k]}"
+    assert abs(float(x["energy"]) - float(y["energy"])) <= 1e-12 * float(x["energy"]), "energy"
+    types.add(x["type"])
+assert {"ball-ball", "ball-shell", "ball-lifter"} <= types, f"types {types}"
+print(f"{len(a)} rows, {sum(int(x['count']) for x in a)} contacts")
+EOF
+  ); then pass "$1: $out"; else fail "$1: $out"; fi
+}
+same_spectra "spectra on 1 and 3 ranks" "$tmp/np1" "$tmp/np3"
+same_spectra "spectra resumed 1 -> 2" "$tmp/np1" "$tmp/rs"
+
+# run.json's mill object: the numbers of --check and a regime over the window.
+if out=$("$py" - "$tmp/np3/run.json" 2>&1 <<'EOF'
+import json, math, sys
+m = json.load(open(sys.argv[1]))["mill"]
+assert abs(m["critical_speed_rad_s"] - math.sqrt(9.81 / 2.5)) < 1e-5, m
+assert abs(m["bed_filling"] - 0.384 / 0.84) < 1e-5, m
+assert m["slice_thickness_m"] == 0.2, m
+assert abs(m["power_per_metre_W"] - m["power_avg_W"] / 0.2) < 1e-6 * m["power_avg_W"], m
+assert m["regime"] in ("slumping", "rolling", "cascading", "cascading-cataracting", "cataracting"), m
+print(m["regime"], round(m["power_avg_W"]), "W")
+EOF
+); then pass "run.json mill: $out"; else fail "run.json mill: $out"; fi
+
+if [ "$failures" -gt 0 ]; then
+  echo "$failures mill test(s) failed"
+  exit 1
+fi
+echo "all mill tests passed"

@@ -1,0 +1,238 @@
+#!/usr/bin/python3
+"""Check a dem2d snapshots.xmf against the snapshots.h5 it describes.
+
+    tests/io/check_xdmf.py DIR/snapshots.xmf [--paraview]
+
+Parses the XDMF with xml.etree and checks, with h5py: the document's shape (one temporal
+collection of spatial collections, each at a time not before the previous one, holding a
+"particles" grid and, when the snapshot has an outline, a "walls" grid); that every HDF
+DataItem names a dataset of the HDF5 file (path relative to the .xmf) with exactly the stated
+Dimensions, NumberType and Precision; that every XML DataItem holds as many numbers as its
+Dimensions say; that topologies, geometries and attributes agree on their sizes and the
+connectivity stays within the points; that the grids are exactly the file's /snapshots and
+/walls groups; and that the material names (Information and the grids' field data) are the
+file's /materials/name. With --paraview, also opens the file with ParaView's three XDMF readers
+(python3-paraview) and checks what each shows at every time step.
+
+Run by tests/io/test_output.cpp (XdmfSidecar.EveryDataItemMatchesTheHdf5File). Exit status: 0
+when every check passes, 1 otherwise (each problem printed), 2 for a usage error.
+"""
+
+import argparse
+import math
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+import numpy as np
+
+DTYPES = {("Float", "8"): np.dtype("<f8"), ("Int", "8"): np.dtype("<i8"), ("Int", "4"): np.dtype("<i4")}
+
+
+class Checker:
+    def __init__(self, xmf):
+        self.xmf = xmf
+        self.problems = []
+        self.items = 0
+
+    def fail(self, where, what):
+        self.problems.append(f"{where}: {what}")
+
+    def data_item(self, item, where, h5):
+        """The values of a DataItem (None after a problem), its Dimensions checked."""
+        self.items += 1
+        dims = tuple(int(d) for d in item.get("Dimensions", "").split())
+        kind = (item.get("NumberType", "Float"), item.get("Precision", "4"))
+        if kind not in DTYPES:
+            self.fail(where, f"unexpected NumberType/Precision {kind}")
+            return None
+        fmt = item.get("Format", "XML")
+        text = (item.text or "").strip()
+        if fmt == "XML":
+            values = text.split()
+            if len(values) != math.prod(dims):
+                self.fail(where, f"{len(values)} inline values for Dimensions {dims}")
+                return None
+            return np.array([float(v) for v in values]).reshape(dims)
+        if fmt != "HDF":
+            self.fail(where, f"unexpected Format {fmt}")
+            return None
+        name, _, path = text.partition(":")
+        if name != os.path.basename(h5.filename):
+            self.fail(where, f"refers to {name}, not {os.path.basename(h5.filename)}")
+            return None
+        if path not in h5 or not isinstance(h5[path], h5py.Dataset):
+            self.fail(where, f"no dataset {path}")
+            return None
+        d = h5[path]
+        if d.shape != dims:
+            self.fail(where, f"{path} has shape {d.shape}, the DataItem says {dims}")
+        if d.dtype != DTYPES[kind]:
+            self.fail(where, f"{path} is {d.dtype}, the DataItem says {kind}")
+        return d[()]
+
+    def grid(self, grid, where, h5):
+        """Checks one uniform grid; returns its name and sizes."""
+        topology, geometry = grid.find("Topology"), grid.find("Geometry")
+        if topology is None or geometry is None:
+            self.fail(where, "no Topology or Geometry")
+            return None
+        if geometry.get("GeometryType") != "XY":
+            self.fail(where, f"GeometryType {geometry.get('GeometryType')}")
+        points = self.data_item(geometry.find("DataItem"), where + "/Geometry", h5)
+        n_points = 0 if points is None else points.shape[0]
+        if points is not None and (points.ndim != 2 or points.shape[1] != 2):
+            self.fail(where, f"geometry of shape {points.shape}, not (N, 2)")
+        elements = int(topology.get("NumberOfElements"))
+        nodes = int(topology.get("NodesPerElement"))
+        kind = topology.get("TopologyType")
+        expected = {"particles": ("Polyvertex", 1), "walls": ("Polyline", 2)}.get(grid.get("Name"))
+        if expected != (kind, nodes):
+            self.fail(where, f"grid {grid.get('Name')} has topology {kind} of {nodes} nodes")
+        item = topology.find("DataItem")
+        if item is None:
+            if elements != 0 or n_points != 0:
+                self.fail(where, f"no connectivity for {elements} elements of {n_points} points")
+        else:
+            cells = self.data_item(item, where + "/Topology", h5)
+            if cells is not None:
+                if cells.size != elements * nodes:
+                    self.fail(where, f"{cells.size} connectivity values for {elements} x {nodes}")
+                if cells.size and (cells.min() < 0 or cells.max() >= n_points):
+                    self.fail(where, f"connectivity outside the {n_points} points")
+        fields = []
+        for attribute in grid.findall("Attribute"):
+            at = f"{where}/Attribute[{attribute.get('Name')}]"
+            values = self.data_item(attribute.find("DataItem"), at, h5)
+            center = attribute.get("Center")
+            if center == "Grid":
+                fields.append((attribute.get("Name"), values))
+            elif center != "Node":
+                self.fail(at, f"Center {center}")
+            elif values is not None:
+                if values.shape[0] != n_points:
+                    self.fail(at, f"{values.shape[0]} values for {n_points} points")
+                want = "Scalar" if values.ndim == 1 else "Vector"
+                if attribute.get("AttributeType") != want:
+                    self.fail(at, f"AttributeType {attribute.get('AttributeType')}, not {want}")
+        return grid.get("Name"), n_points, elements, fields
+
+    def document(self, h5):
+        try:
+            root = ET.parse(self.xmf).getroot()
+        except ET.ParseError as e:
+            self.fail(self.xmf, f"not well-formed XML: {e}")
+            return None
+        if root.tag != "Xdmf" or root.get("Version") != "3.0":
+            self.fail("/Xdmf", "not an XDMF 3 document")
+        domain = root.find("Domain")
+        names = [n.decode() if isinstance(n, bytes) else str(n) for n in h5["materials/name"][()]]
+        info = domain.find("Information")
+        lookup = ",".join(f"{k}={n}" for k, n in enumerate(names))
+        if names and (info is None or info.get("Name") != "material_names" or info.get("Value") != lookup):
+            self.fail("/Domain/Information", f"not material_names = {lookup}")
+        temporal = domain.findall("Grid")
+        if len(temporal) != 1 or temporal[0].get("CollectionType") != "Temporal":
+            self.fail("/Domain", "not one temporal collection")
+            return
+        last, seen_snapshots, seen_walls = -math.inf, [], []
+        for step in temporal[0].findall("Grid"):
+            where = f"/Domain/Grid/Grid[{step.get('Name')}]"
+            if step.get("CollectionType") != "Spatial":
+                self.fail(where, "not a spatial collection")
+                continue
+            time = float(step.find("Time").get("Value"))
+            if time < last:
+                self.fail(where, f"time {time} before {last}")
+            last = time
+            snapshot = step.get("Name").removeprefix("snapshot_")
+            grids = [self.grid(g, f"{where}/Grid[{g.get('Name')}]", h5) for g in step.findall("Grid")]
+            kinds = [g[0] for g in grids if g]
+            if kinds not in (["particles"], ["particles", "walls"]):
+                self.fail(where, f"grids {kinds}")
+                continue
+            seen_snapshots.append(snapshot)
+            if "walls" in kinds:
+                seen_walls.append(snapshot)
+            if float(h5["snapshots"][snapshot].attrs["time"]) != time:
+                self.fail(where, "time differs from the group's attribute")
+            fields = dict(grids[0][3])
+            wanted = {f"material: {n}": k for k, n in enumerate(names)}
+            if set(fields) != set(wanted) or any(fields[f] is None or fields[f].tolist() != [wanted[f]] for f in wanted):
+                self.fail(where, f"material field data {sorted(fields)}, not {sorted(wanted)}")
+        if seen_snapshots != sorted(h5["snapshots"]):
+            self.fail("/Domain/Grid", f"lists {seen_snapshots}, the file holds {sorted(h5['snapshots'])}")
+        walls = sorted(h5["walls"]) if "walls" in h5 else []
+        if seen_walls != walls:
+            self.fail("/Domain/Grid", f"walls of {seen_walls}, the file holds {walls}")
+        return seen_snapshots
+
+
+def check_paraview(xmf, h5, snapshots, problems):
+    """Opens `xmf` with ParaView's three XDMF readers; each must show, at every time step, the
+    particles (a point per particle) and the outline (a cell per segment)."""
+    from paraview import servermanager
+    from paraview import simple
+
+    readers = {"XDMF Reader": lambda: simple.XDMFReader(FileNames=[xmf]),
+               "Xdmf3 Reader S": lambda: simple.Xdmf3ReaderS(FileName=[xmf]),
+               "Xdmf3 Reader T": lambda: simple.Xdmf3ReaderT(FileName=[xmf])}
+    for label, make in readers.items():
+        reader = make()
+        reader.UpdatePipelineInformation()
+        values = reader.TimestepValues
+        times = [float(t) for t in values] if hasattr(values, "__iter__") else [float(values)]
+        if not times and len(snapshots) == 1:  # one snapshot: no time steps
+            times = [float(h5["snapshots"][snapshots[0]].attrs["time"])]
+        if len(times) != len(snapshots):
+            problems.append(f"{label}: {len(times)} time steps for {len(snapshots)} snapshots")
+            continue
+        for name, time in zip(snapshots, times):
+            reader.UpdatePipeline(time)
+            data = servermanager.Fetch(reader)
+            blocks = []
+            it = data.NewIterator()
+            it.InitTraversal()
+            while not it.IsDoneWithTraversal():
+                ds = it.GetCurrentDataObject()
+                blocks.append((ds.GetNumberOfPoints(), ds.GetNumberOfCells(), ds.GetPointData().GetArray("speed") is not None))
+                it.GoToNextItem()
+            n = h5["snapshots"][name]["id"].shape[0]
+            want = [(n, n, True)]
+            if "walls" in h5 and name in h5["walls"]:
+                w = h5["walls"][name]
+                want.append((w["points"].shape[0], w["segments"].shape[0], False))
+            if n == 0:  # no particles: the readers show an empty block without arrays, or none
+                blocks = [b for b in blocks if b[:2] != (0, 0)]
+                want = want[1:]
+            if blocks != want:
+                problems.append(f"{label}: snapshot {name} at t = {time}: blocks (points, cells, speed) "
+                                f"{blocks}, not {want}")
+        simple.Delete(reader)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("xmf", help="snapshots.xmf written by dem2d")
+    parser.add_argument("--paraview", action="store_true", help="also open it with ParaView's readers")
+    args = parser.parse_args(argv)
+    xmf = os.path.abspath(args.xmf)  # the Xdmf3 readers resolve the .h5 from the .xmf's folder
+    h5_path = os.path.join(os.path.dirname(xmf), "snapshots.h5")
+    checker = Checker(xmf)
+    with h5py.File(h5_path, "r") as h5:
+        snapshots = checker.document(h5)
+        if args.paraview and snapshots and not checker.problems:
+            check_paraview(xmf, h5, snapshots, checker.problems)
+    for p in checker.problems:
+        print(p)
+    if checker.problems:
+        print(f"check_xdmf: {xmf}: {len(checker.problems)} problems")
+        return 1
+    print(f"check_xdmf: {xmf}: {len(snapshots or [])} time steps, {checker.items} DataItems, all match"
+          + (", and ParaView's three XDMF readers show them" if args.paraview else ""))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,209 @@
+#!/bin/bash
+# The mill post-processing scripts on a short real run: post/report.py, post/plot_series.py and
+# post/sweep.py exit 0, write every file they promise as a real picture (a PNG of some size with
+# more than a few colours), and what they print agrees with series.csv read independently here
+# (mean power, regime, critical speed; the sweep's speeds and powers).
+#
+#   tests/post/test_post.sh [DEM2D [SOURCE_DIR]]
+#
+# DEM2D defaults to SOURCE_DIR/build/src/dem2d, SOURCE_DIR to this script's repository. Uses
+# /usr/bin/python3 (numpy, matplotlib, h5py). Everything is written in a temporary folder that
+# is removed at the end. About 20-40 s on two busy cores.
+set -u
+
+source_dir=${2:-$(cd "$(dirname "$0")/../.." && pwd)}
+dem2d=${1:-$source_dir/build/src/dem2d}
+py=/usr/bin/python3
+post=$source_dir/post
+deck=$source_dir/inputs/waterfall.in
+work=$(mktemp -d "${TMPDIR:-/tmp}/dem2d_post.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+export MPLBACKEND=Agg
+
+passed=0
+failed=0
+pass() {
+  echo "ok   $1"
+  passed=$((passed + 1))
+}
+fail() {
+  echo "FAIL $1"
+  failed=$((failed + 1))
+}
+# check NAME COMMAND...: pass when COMMAND exits 0, else fail with its output.
+check() {
+  local name=$1 out
+  shift
+  if out=$("$@" 2>&1); then pass "$name"; else
+    fail "$name"
+    sed -n '1,15p' <<<"$out"
+  fi
+}
+
+# png_ok FILE...: each file is a PNG at least 200 px wide with more than 20 colours (not blank).
+png_ok() {
+  "$py" - "$@" <<'EOF'
+import sys
+import matplotlib.image as mpimg
+import numpy as np
+for path in sys.argv[1:]:
+    with open(path, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n", f"{path}: not a PNG"
+    img = mpimg.imread(path)
+    assert img.shape[0] >= 200 and img.shape[1] >= 200, f"{path}: {img.shape}"
+    colours = np.unique((img[..., :3] * 255).astype(np.uint8).reshape(-1, 3), axis=0)
+    assert len(colours) > 20, f"{path}: only {len(colours)} colours"
+EOF
+}
+
+# --- A short run: 0.8 s of the waterfall deck, snapshots every 0.1 s, spectra on ------------------
+run=$work/run
+start=$SECONDS
+check "dem2d: a 0.8 s waterfall run" \
+  "$dem2d" "$deck" --output "$run" --overwrite --quiet --set run.duration=0.8 \
+  --set drum.ramp_time=0.1 --set output.snapshot_interval=0.1 \
+  --set output.collision_spectra=true --set output.analysis_window=0.2
+if [ ! -s "$run/series.csv" ]; then
+  echo "no series.csv: nothing to post-process"
+  echo "$passed passed, $((failed + 1)) failed"
+  exit 1
+fi
+
+# --- The sweep runs in the background while the report is drawn ----------------------------------
+sweep=$work/sweep
+"$py" "$post/sweep.py" "$deck" --fractions 0.4,0.9 --duration 0.5 --jobs 2 -o "$sweep" \
+  --dem2d "$dem2d" --set drum.ramp_time=0.1 --set output.snapshot_interval=0.25 \
+  >"$work/sweep.log" 2>&1 &
+sweep_pid=$!
+
+# --- report.py ----------------------------------------------------------------------------------
+report=$work/report
+check "report.py exits 0" "$py" "$post/report.py" "$run" -o "$report" --max-frames 8 \
+  --snapshots 2
+expected=(energies.png power.png charge_shape.png charge_000.400s.png charge_000.800s.png
+          report.md index.html)
+if [ -f "$run/collisions.csv" ]; then expected+=(collisions.png); fi
+if command -v ffmpeg >/dev/null; then expected+=(charge.mp4); fi
+missing=""
+for f in "${expected[@]}"; do [ -s "$report/$f" ] || missing+=" $f"; done
+if [ -z "$missing" ]; then pass "report.py wrote ${expected[*]}"; else
+  fail "report.py did not write:$missing"
+fi
+if [ -f "$run/collisions.csv" ]; then
+  echo "note: dem2d wrote collisions.csv; report.py drew it"
+else
+  echo "note: dem2d wrote no collisions.csv: collisions.png is checked on a made-up one below"
+fi
+
+# The index's numbers against series.csv and run.json read here.
+check "report.md: critical speed, fraction, regime and mean power agree with series.csv" \
+  "$py" - "$run" "$report/report.md" <<'EOF'
+import csv, json, math, re, sys
+run, md = sys.argv[1], open(sys.argv[2], encoding="utf-8").read()
+rows = list(csv.DictReader(open(f"{run}/series.csv", encoding="ascii")))
+t = [float(r["time"]) for r in rows]
+half = [r for r in rows if float(r["time"]) >= t[-1] / 2]
+work = float(half[-1]["drum_work"]) - float(half[0]["drum_work"])
+power = work / (float(half[-1]["time"]) - float(half[0]["time"]))
+regimes = [r["regime"] for r in half if r["regime"] != "-"]
+assert regimes, "the run's regime column is '-' over the last half"
+regime = max(sorted(set(regimes)), key=regimes.count)
+assert re.search(rf"\| regime \| {regime} ", md), f"report.md lacks '| regime | {regime}'"
+m = re.search(r"\| mean drive power, last half of the run \| ([0-9.e+-]+) kW", md)
+assert m and math.isclose(float(m.group(1)) * 1e3, power, rel_tol=1e-3), (m and m.group(1), power)
+assert power > 0, power
+deck = json.load(open(f"{run}/run.json"))["deck"]
+wc = math.sqrt(9.81 / deck["drum"]["radius"])
+assert f"{wc:.4g} rad/s" in md, f"critical speed {wc:.4g} rad/s not in report.md"
+assert f"| fraction of critical speed | {deck['drum']['speed'] / wc:.3f} |" in md
+assert "| slice thickness (2D power is for this slice) | 0.2 m" in md
+assert "kW/m" in md and "charge_000.800s.png" in md and "energies.png" in md
+print(f"regime {regime}, mean power {power / 1e3:.4g} kW")
+EOF
+# shown FILE...: index.html shows each picture.
+shown() {
+  local f
+  for f in "$@"; do
+    grep -q "src='$f'" "$report/index.html" || { echo "not shown: $f"; return 1; }
+  done
+}
+check "index.html shows every picture" shown energies.png power.png charge_shape.png \
+  charge_000.800s.png
+if command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null; then
+  frames=$(ffprobe -v error -count_frames -select_streams v:0 -show_entries \
+    stream=nb_read_frames -of csv=p=0 "$report/charge.mp4" 2>/dev/null)
+  if [ "$frames" = 8 ]; then pass "charge.mp4 has --max-frames 8 frames"; else
+    fail "charge.mp4 has '$frames' frames, expected 8"
+  fi
+fi
+
+# The collision spectra on a made-up collisions.csv of the documented layout (two types, one
+# size class, log bins from 0 J, an open last bin), in a copy of the run folder.
+fake=$work/fake
+mkdir -p "$fake"
+cp "$run/series.csv" "$run/run.json" "$fake/"
+"$py" - "$fake/collisions.csv" <<'EOF'
+import sys
+edges = [0.0] + [1e-12 * 10 ** (k / 10) for k in range(181)] + [float("inf")]
+with open(sys.argv[1], "w", encoding="ascii") as f:
+    f.write("type,size_min,size_max,energy_min,energy_max,count,energy\n")
+    for kind, centre in [("ball-ball", 100), ("ball-shell", 120)]:
+        for size_min, size_max in [(0.128, 0.256), (0.256, float("inf"))]:
+            for i in range(len(edges) - 1):
+                count = max(0, 50 - abs(i - centre)) if size_min < 0.2 else 0
+                lo, hi = edges[i], edges[i + 1]
+                f.write(f"{kind},{size_min},{size_max},{lo!r},{hi!r},{count},12.5\n")
+EOF
+check "report.py without snapshots, with a made-up collisions.csv" \
+  "$py" "$post/report.py" "$fake" --no-animation
+charges=("$fake"/report/charge_0*.png)
+if grep -q "collisions.png" "$fake/report/report.md" && [ ! -e "${charges[0]}" ]; then
+  pass "report.md lists collisions.png; no charge pictures without snapshots.h5"
+else fail "report on the made-up folder"; fi
+
+# --- plot_series.py -----------------------------------------------------------------------------
+if out=$("$py" "$post/plot_series.py" "$run/series.csv" -o "$work/series.png" 2>&1) &&
+  grep -q "mean power over the last half" <<<"$out"; then
+  pass "plot_series.py SERIES -o PNG exits 0 and prints the mean power"
+else fail "plot_series.py: $out"; fi
+
+# --- Refusals -------------------------------------------------------------------------------------
+if "$py" "$post/report.py" "$work/nowhere" >/dev/null 2>&1; then
+  fail "report.py on a missing folder exits 0"
+else pass "report.py on a missing folder exits non-zero"; fi
+if "$py" "$post/sweep.py" "$deck" --fractions 0.5,-1 -o "$work/bad" >/dev/null 2>&1; then
+  fail "sweep.py --fractions 0.5,-1 exits 0"
+else pass "sweep.py refuses a negative fraction"; fi
+
+# --- sweep.py -------------------------------------------------------------------------------------
+if wait "$sweep_pid"; then pass "sweep.py (2 fractions, 0.5 s) exits 0"; else
+  fail "sweep.py exited non-zero"
+  sed -n '1,20p' "$work/sweep.log"
+fi
+check "sweep.csv: 2 rows, speeds f * sqrt(g/R), finite positive power rising with speed" \
+  "$py" - "$sweep/sweep.csv" <<'EOF'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1], encoding="ascii")))
+assert len(rows) == 2, rows
+assert [float(r["fraction"]) for r in rows] == [0.4, 0.9], rows
+wc = math.sqrt(9.81 / 2.5)
+for r in rows:
+    f = float(r["fraction"])
+    assert math.isclose(float(r["speed_rad_s"]), f * wc, rel_tol=1e-5), r
+    assert math.isclose(float(r["speed_rpm"]), f * wc * 30 / math.pi, rel_tol=1e-5), r
+    assert r["regime"] in {"slumping", "rolling", "cascading", "cataracting", "centrifuging"}, r
+low, high = (float(r["power_W"]) for r in rows)
+assert math.isfinite(high) and high > 0, high
+assert high > low > 0, (low, high)
+assert math.isclose(float(rows[1]["power_per_metre_W"]), high / 0.2, rel_tol=1e-4), rows[1]
+print(f"power {low / 1e3:.3g} kW at 0.4, {high / 1e3:.3g} kW at 0.9 of critical")
+EOF
+check "every PNG is a real picture (report, made-up spectra, plot_series, sweep)" \
+  png_ok "$report"/*.png "$fake/report/collisions.png" "$work/series.png" \
+  "$sweep/power_vs_speed.png"
+if grep -qE "^ +0\.9 .*kW/m|^ +0\.9 " "$work/sweep.log"; then pass "sweep.py printed its table"
+else fail "sweep.py printed no table row for 0.9"; sed -n '1,20p' "$work/sweep.log"; fi
+
+echo "post-processing tests: $((SECONDS - start)) s"
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
