@@ -506,7 +506,11 @@ std::unique_ptr<Simulation> make_simulation(const Options& opt, const Scene& sce
                      fmt_double(" at or past run.duration = %.10g s: nothing to run; give a "
                                 "longer duration, e.g. --set run.duration=...",
                                 scene.run.duration));
-  return std::make_unique<Simulation>(scene, &domain, &r);
+  try {
+    return std::make_unique<Simulation>(scene, &domain, &r);
+  } catch (const InputError& e) {  // the checkpoint does not fit this deck
+    throw InputError(scene.deck_path + ": error: --restart " + opt.restart + ": " + e.what());
+  }
 }
 
 std::unique_ptr<SnapshotWriter> open_snapshots(const Scene& scene, const Simulation& sim,

@@ -78,8 +78,16 @@ void Simulation::set_up_analytics(const Resumption* resume) {
   std::vector<bool> ore(scene_.materials.size(), false);
   if (grinding_) ore[static_cast<std::size_t>(grinding_->ore_material())] = true;
   spectra_ = std::make_unique<CollisionSpectra>(std::move(edges), std::move(ore));
-  if (resume && domain_->rank() == 0 &&
-      resume->state.spectra_counts.size() == spectra_->counts().size()) {
+  if (!resume) return;
+  // The counts cannot be rebinned: other size classes than the checkpoint's are refused (every
+  // rank reads the same checkpoint, so every rank refuses alike).
+  if (resume->state.spectra_counts.size() != spectra_->counts().size())
+    throw InputError("the checkpoint's collision spectra have " +
+                     std::to_string(resume->state.spectra_counts.size()) +
+                     " bins, this deck's output.size_class_min and size_class_ratio give " +
+                     std::to_string(spectra_->counts().size()) +
+                     "; keep the checkpoint's size classes to continue its spectra");
+  if (domain_->rank() == 0) {
     spectra_->counts() = resume->state.spectra_counts;
     spectra_->energies() = resume->state.spectra_energies;
   }

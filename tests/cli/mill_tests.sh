@@ -48,6 +48,10 @@ mpirun -np 3 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$tmp/np3" > "$
   fail "np3 run: $(cat "$tmp/np3.log")"
 "$dem2d" "$wf" "${run[@]}" --set run.duration=0.15 --output "$tmp/rs" > "$tmp/rs.log" 2>&1 ||
   fail "first half: $(cat "$tmp/rs.log")"
+# The spectra cannot be rebinned: a restart with other size classes is refused (and changes
+# nothing: the restart below continues the same folder).
+expect_joined "restart with other size classes" 2 "waterfall\\.in: error: --restart .*checkpoint\\.h5: the checkpoint's collision spectra have [0-9]+ bins.*size_class_ratio give [0-9]+" -- \
+  "$dem2d" "$wf" "${run[@]}" --set output.size_class_ratio=3 --output "$tmp/rs" --restart "$tmp/rs/checkpoint.h5"
 mpirun -np 2 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$tmp/rs" --restart "$tmp/rs/checkpoint.h5" \
   > "$tmp/rs2.log" 2>&1 || fail "restart: $(cat "$tmp/rs2.log")"
 
