@@ -38,30 +38,13 @@ std::string collisions_csv(const CollisionSpectra& s) {
   return out;
 }
 
-namespace {
-
-std::string write_text(const std::string& path, const std::string& text) {
-  const std::string temporary = path + ".tmp";
-  std::FILE* f = std::fopen(temporary.c_str(), "wb");
-  if (f == nullptr) return fmt::format("cannot write {}: {}", path, std::strerror(errno));
-  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const int error = errno;
-  if (std::fclose(f) != 0 || !written || std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    return fmt::format("cannot write {}: {}", path, std::strerror(written ? errno : error));
-  }
-  return {};
-}
-
-}  // namespace
-
 void write_collisions(MPI_Comm comm, const std::string& directory, const CollisionSpectra& mine) {
   CollisionSpectra global = mine;
   mpi::sum_in_place(comm, std::span<std::int64_t>(global.counts()));
   mpi::sum_in_place(comm, std::span<double>(global.energies()));
   std::string error;
   if (mpi::rank(comm) == 0)
-    error = write_text(directory + "/" + kCollisionsFile, collisions_csv(global));
+    error = write_file_atomically(directory + "/" + kCollisionsFile, collisions_csv(global));
   mpi::agree_on_failure<IoError>(comm, error);
 }
 

@@ -62,4 +62,9 @@ OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, Claim h
 // here, before the write; the files written so far stay whole.
 void ensure_free_space(MPI_Comm comm, const std::string& path, std::uint64_t bytes);
 
+// Writes `text` to `path` through a temporary file and a rename, so that a reader never sees
+// a half-written file (snapshots.xmf, collisions.csv). Returns an error message, empty on
+// success.
+std::string write_file_atomically(const std::string& path, const std::string& text);
+
 }  // namespace dem2d

@@ -236,28 +236,6 @@ bool write_at(int fd, std::string_view text, off_t offset) {
   return true;
 }
 
-// Writes `text` to `path` through a temporary file and a rename, so that a reader never sees
-// a half-written file. Returns an error message, empty on success.
-std::string write_file_atomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (f == nullptr) return fmt::format("cannot create {}: {}", tmp, std::strerror(errno));
-  const bool written = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  const int write_errno = errno;
-  if (std::fclose(f) != 0 || !written) {
-    const int e = written ? errno : write_errno;
-    std::remove(tmp.c_str());
-    return fmt::format("cannot write {}: {}", tmp, std::strerror(e));
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    return fmt::format("cannot rename {} to {}: {}", tmp, path, ec.message());
-  }
-  return {};
-}
-
 }  // namespace
 
 std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles) {
