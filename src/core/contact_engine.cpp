@@ -65,9 +65,11 @@ HistoryRecords ContactEngine::records() const {
   const auto live = [&](const double* h) {
     return std::any_of(h, h + width, [](double v) { return v != 0.0; });
   };
-  for (std::size_t k = 0; k < pairs_.size(); ++k)
+  for (std::size_t t = 0; t < pairs_.size(); ++t) {
+    const std::size_t k = pairs_.entry(t);  // in key order
     if (live(pairs_.history_of(k)))
       out.push_back(pairs_.id_i[k], pairs_.id_j[k], pairs_.history_of(k));
+  }
   for (std::size_t k = 0; k < wall_pairs_.size(); ++k)
     if (live(wall_pairs_.history_of(k)))
       out.push_back(wall_pairs_.id[k], -1 - static_cast<std::int64_t>(wall_pairs_.element[k]),

@@ -97,6 +97,7 @@ class ContactEngine {
   // model has none).
   std::size_t history_offset(std::string_view name) const;
   std::int64_t builds() const { return search_.builds(); }
+  double far_fraction() const { return search_.far_fraction(); }
 
  private:
   PairTable table_;

@@ -139,6 +139,8 @@ class Kernel final : public ContactKernel {
                     std::int32_t element, double dt, const double* h);
   void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
+  void write_records(PairList& pl, std::size_t n);
+  void sum_records(ParticleStore& p, const PairList& pl);
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                      EvaluationTotals& tot);
   std::size_t gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl);
@@ -166,6 +168,13 @@ class Kernel final : public ContactKernel {
   bool rescan_ = true;
   ContactBatch b_;
   WallBatch wb_;
+  // With the list in storage order: per entry, in contact in this evaluation; per entry, the
+  // force, torque and elastic force on i (2k) and on j (2k + 1).
+  struct ForceRecord {
+    double fx, fy, t, ex, ey;
+  };
+  Array<std::uint8_t> touch_;
+  Array<ForceRecord> records_;
 };
 
 // The candidates are processed in chunks, each through phases A, B and C, so that the batch
@@ -177,6 +186,10 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
                                   EvaluationTotals& tot) {
   constexpr std::size_t kChunk = 512;
   b_.reserve(kChunk + kPackSize);
+  if (!pl.canonical() && touch_.size() != pl.size()) {
+    touch_.assign(pl.size(), 0);
+    records_.resize(2 * pl.size());
+  }
   Pack dissipated(0.0), elastic(0.0);
   double max_ratio = 0.0;
   for (std::size_t k0 = 0; k0 < pl.size(); k0 += kChunk) {
@@ -202,6 +215,7 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
     }
     max_ratio = std::max(max_ratio, chunk_max);
   }
+  if (!pl.canonical()) sum_records(p, pl);
   tot.dissipated = stdx::reduce(dissipated);
   tot.elastic = stdx::reduce(elastic);
   tot.max_overlap = max_ratio;
@@ -281,6 +295,8 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
   const Vec2* x = p.pos.data();
   const double* r = p.radius.data();
   double* trial = pl.trial.data();
+  const bool records = !pl.canonical();
+  std::uint8_t* touch = touch_.data();
   std::size_t n = 0;
   for (std::size_t k = k0; k < k1; ++k) {
     const std::int32_t i = pl.i[k], j = pl.j[k];
@@ -295,6 +311,10 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
     // Written so that a NaN distance counts as a contact: its NaN forces are then caught by the
     // stability check instead of the particle silently dropping out of every contact.
     n += !(dist2 >= rsum * rsum) ? 1 : 0;
+  }
+  if (records) {  // apart from the loop above: a byte store there aliases everything
+    std::fill(touch + k0, touch + k1, std::uint8_t{0});
+    for (std::size_t c = 0; c < n; ++c) touch[b_.pair[c]] = 1;
   }
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
@@ -380,9 +400,11 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
   }
 }
 
-// C. Scatter in canonical pair order.
+// C. Scatter in canonical pair order; or, with the list in storage order, the two force records
+// of each contact (sum_records adds them up in canonical order).
 template <class Model>
 void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n) {
+  if (!pl.canonical()) return write_records(pl, n);
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
@@ -400,6 +422,48 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
     f_el[j] -= ei;
     for (std::size_t s = 0; s < W; ++s)
       trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
+  }
+}
+
+template <class Model>
+void Kernel<Model>::write_records(PairList& pl, std::size_t n) {
+  double* trial = pl.trial.data();
+  ForceRecord* rec = records_.data();
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::size_t k = static_cast<std::size_t>(b_.pair[c]);
+    rec[2 * k] = {b_.fx[c], b_.fy[c], b_.t_i[c], b_.ex[c], b_.ey[c]};
+    rec[2 * k + 1] = {-b_.fx[c], -b_.fy[c], b_.t_j[c], -b_.ex[c], -b_.ey[c]};
+    for (std::size_t s = 0; s < W; ++s) trial[k * W + s] = b_.history.fresh[s][c];
+  }
+}
+
+// Each owned particle's pair forces added in the order of its partners' ids, as the canonical
+// scatter adds them (f - g and f + (-g) are the same number); the records of candidates not in
+// contact are passed over (they hold an earlier evaluation's values).
+template <class Model>
+void Kernel<Model>::sum_records(ParticleStore& p, const PairList& pl) {
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  Vec2* f_el = p.elastic_force.data();
+  const ForceRecord* rec = records_.data();
+  const std::uint8_t* touch = touch_.data();
+  const std::int32_t* index = pl.records.data();
+  const std::size_t n_owned = pl.record_start.size() - 1;
+  for (std::size_t q = 0; q < n_owned; ++q) {
+    Vec2 fq = f[q], eq = f_el[q];
+    double tq_q = tq[q];
+    for (std::int32_t s = pl.record_start[q]; s < pl.record_start[q + 1]; ++s) {
+      const std::int32_t r = index[s];
+      const ForceRecord& g = rec[r];
+      // Selects, not a branch: whether a candidate touches is close to random.
+      const bool on = touch[r >> 1] != 0;
+      fq = on ? fq + Vec2{g.fx, g.fy} : fq;
+      tq_q = on ? tq_q + g.t : tq_q;
+      eq = on ? eq + Vec2{g.ex, g.ey} : eq;
+    }
+    f[q] = fq;
+    tq[q] = tq_q;
+    f_el[q] = eq;
   }
 }
 

@@ -9,10 +9,11 @@ namespace dem2d {
 
 namespace {
 
-// Carry histories (`width` values per contact) from `old` (sorted keys) to `fresh` (sorted
-// keys) by key equality; new contacts start at zero.
-template <class KeyOld, class KeyNew>
-void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old,
+// Carry histories (`width` values per contact) from `old` to `fresh` by key equality; new
+// contacts start at zero. key_old(a) and key_new(b) are sorted; old_entry(a) is where the a-th
+// old key's history sits.
+template <class KeyOld, class KeyNew, class OldEntry>
+void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old, OldEntry old_entry,
                    const Array<double>& hist_old, std::size_t n_new, KeyNew key_new,
                    Array<double>& hist_new) {
   hist_new.assign(n_new * width, 0.0);
@@ -22,7 +23,44 @@ void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old,
     const auto kb = key_new(b);
     while (a < n_old && key_old(a) < kb) ++a;
     if (a < n_old && key_old(a) == kb)
-      std::copy_n(&hist_old[a * width], width, &hist_new[b * width]);
+      std::copy_n(&hist_old[old_entry(a) * width], width, &hist_new[b * width]);
+  }
+}
+
+// Reorder `pl` (built in canonical order) by (lower local index of the pair, canonical order):
+// sets key_order, and each owned particle's records (2k as i, 2k + 1 as j) in canonical order,
+// which is the order of its partners' ids (core/neighbors.hpp).
+void to_storage_order(std::size_t n, std::size_t n_owned, PairList& pl) {
+  const std::size_t m = pl.size();
+  std::vector<std::int32_t> start(n + 1, 0);
+  for (std::size_t k = 0; k < m; ++k) ++start[std::min(pl.i[k], pl.j[k]) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  pl.key_order.resize(m);
+  for (std::size_t k = 0; k < m; ++k) pl.key_order[k] = start[std::min(pl.i[k], pl.j[k])]++;
+  const auto permute = [&]<class T>(Array<T>& a, std::size_t width) {
+    Array<T> out(a.size());
+    for (std::size_t k = 0; k < m; ++k)
+      std::copy_n(&a[k * width], width, &out[static_cast<std::size_t>(pl.key_order[k]) * width]);
+    a.swap(out);
+  };
+  permute(pl.i, 1);
+  permute(pl.j, 1);
+  permute(pl.id_i, 1);
+  permute(pl.id_j, 1);
+  permute(pl.history, pl.width);
+  pl.record_start.assign(n_owned + 1, 0);
+  const auto owned = [&](std::int32_t q) { return static_cast<std::size_t>(q) < n_owned; };
+  for (std::size_t k = 0; k < m; ++k) {
+    if (owned(pl.i[k])) ++pl.record_start[pl.i[k] + 1];
+    if (owned(pl.j[k])) ++pl.record_start[pl.j[k] + 1];
+  }
+  std::partial_sum(pl.record_start.begin(), pl.record_start.end(), pl.record_start.begin());
+  pl.records.resize(static_cast<std::size_t>(pl.record_start[n_owned]));
+  std::vector<std::int32_t> fill(pl.record_start.begin(), pl.record_start.end() - 1);
+  for (std::size_t t = 0; t < m; ++t) {
+    const std::int32_t k = pl.key_order[t];
+    if (owned(pl.i[k])) pl.records[fill[pl.i[k]]++] = 2 * k;
+    if (owned(pl.j[k])) pl.records[fill[pl.j[k]]++] = 2 * k + 1;
   }
 }
 
@@ -31,51 +69,136 @@ void merge_history(std::size_t width, std::size_t n_old, KeyOld key_old,
 void NeighborSearch::build(const ParticleStore& p, const Walls& walls, double skin, PairList& pairs,
                            WallPairList& wall_pairs) {
   ++builds_;
-  // Indices in id order (the identity when the store is kept sorted by id).
-  const std::size_t n = p.size();
-  order_.resize(n);
-  std::iota(order_.begin(), order_.end(), 0);
-  if (!std::is_sorted(p.id.data(), p.id.data() + n))
-    std::sort(order_.begin(), order_.end(), [&](int a, int b) { return p.id[a] < p.id[b]; });
+  sort_by_id(p);
   build_particle_pairs(p, skin, pairs);
   build_wall_pairs(p, walls, skin, wall_pairs);
 }
 
-// Counting sort of the particles (owned and ghosts) into a grid of cells of side at least the
-// largest reach 2 r_max + skin; sets nx_, ny_, cell_start_, cell_items_, cell_of_.
+// Indices in id order: the owned particles' order is kept while the store's layout holds (the
+// identity when the store is in id order), the ghosts' (new at every parallel rebuild) merged in.
+void NeighborSearch::sort_by_id(const ParticleStore& p) {
+  const std::size_t n_owned = p.n_owned(), n = p.size();
+  const auto by_id = [&](std::int32_t a, std::int32_t b) { return p.id[a] < p.id[b]; };
+  if (layout_ != p.layout() || owned_order_.size() != n_owned) {
+    owned_order_.resize(n_owned);
+    std::iota(owned_order_.begin(), owned_order_.end(), 0);
+    if (!std::is_sorted(p.id.data(), p.id.data() + n_owned))
+      std::sort(owned_order_.begin(), owned_order_.end(), by_id);
+    layout_ = p.layout();
+    id_ordered_ = std::is_sorted(p.id.data(), p.id.data() + n_owned);
+  }
+  order_.resize(n);
+  std::copy(owned_order_.begin(), owned_order_.end(), order_.begin());
+  if (n == n_owned) return;
+  std::iota(order_.begin() + static_cast<std::ptrdiff_t>(n_owned), order_.end(),
+            static_cast<std::int32_t>(n_owned));
+  std::sort(order_.begin() + static_cast<std::ptrdiff_t>(n_owned), order_.end(), by_id);
+  std::inplace_merge(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(n_owned),
+                     order_.end(), by_id);
+}
+
+// Counting sort of the particles (owned and ghosts) into one grid per size level. Level l holds
+// the radii in (r_max / 2^(l+1), r_max / 2^l] (the last level everything smaller), and its cells
+// have a side of at least its largest reach 2 R_l + skin, so a particle finds its partners of
+// level l in the few cells within r_i + R_l + skin. One level (size ratio below 2) is the plain
+// cell grid; with a wide size range a small particle no longer scans cells sized for the
+// largest ones (up to a hundred small particles each at 10:1).
 void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
   const std::size_t n = p.size();
-  double r_max = 0.0;
+  double r_max = 0.0, r_min = std::numeric_limits<double>::max();
   Vec2 lo{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()};
   Vec2 hi{-lo.x, -lo.y};
   for (std::size_t k = 0; k < n; ++k) {
     r_max = std::max(r_max, p.radius[k]);
+    r_min = std::min(r_min, p.radius[k]);
     lo = {std::min(lo.x, p.pos[k].x), std::min(lo.y, p.pos[k].y)};
     hi = {std::max(hi.x, p.pos[k].x), std::max(hi.y, p.pos[k].y)};
   }
-  // Cell side: the largest reach, enlarged if the box would need far more cells than particles.
-  double h = 2.0 * r_max + skin;
-  const double area = std::max(hi.x - lo.x, h) * std::max(hi.y - lo.y, h);
-  const double max_cells = 4.0 * static_cast<double>(n) + 1024.0;
-  if (area / (h * h) > max_cells) h = std::sqrt(area / max_cells);
-  nx_ = static_cast<int>((hi.x - lo.x) / h) + 1;
-  ny_ = static_cast<int>((hi.y - lo.y) / h) + 1;
-  const double inv_h = 1.0 / h;
-  cell_start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
+  lo_ = lo;
+  int n_levels = 1;
+  while (n_levels < kMaxLevels && std::ldexp(r_min, n_levels) < r_max) ++n_levels;
+  levels_.resize(static_cast<std::size_t>(n_levels));
+  level_of_.resize(n);
+  for (Level& l : levels_) {
+    l.r_max = 0.0;
+    l.count = 0;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    int l = 0;
+    while (l + 1 < n_levels && p.radius[k] <= std::ldexp(r_max, -(l + 1))) ++l;
+    level_of_[k] = static_cast<std::int8_t>(l);
+    levels_[l].r_max = std::max(levels_[l].r_max, p.radius[k]);
+    ++levels_[l].count;
+  }
+  for (Level& l : levels_) {
+    // Cell side: the level's largest reach, enlarged if the box would need far more cells than
+    // the level has particles.
+    double h = 2.0 * l.r_max + skin;
+    const double area = std::max(hi.x - lo.x, h) * std::max(hi.y - lo.y, h);
+    const double max_cells = 4.0 * static_cast<double>(l.count) + 1024.0;
+    if (area / (h * h) > max_cells) h = std::sqrt(area / max_cells);
+    l.inv_h = 1.0 / h;
+    l.nx = static_cast<int>((hi.x - lo.x) / h) + 1;
+    l.ny = static_cast<int>((hi.y - lo.y) / h) + 1;
+    l.start.assign(static_cast<std::size_t>(l.nx) * l.ny + 1, 0);
+  }
   cell_of_.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
-    // A non-finite position (a run blowing up: the stability check reports it) goes to cell 0
-    // rather than to an undefined cell index.
-    const double fx = (p.pos[k].x - lo.x) * inv_h, fy = (p.pos[k].y - lo.y) * inv_h;
-    const int cx = std::isfinite(fx) ? std::min(nx_ - 1, static_cast<int>(fx)) : 0;
-    const int cy = std::isfinite(fy) ? std::min(ny_ - 1, static_cast<int>(fy)) : 0;
-    cell_of_[k] = cy * nx_ + cx;
-    ++cell_start_[cell_of_[k] + 1];
+    Level& l = levels_[level_of_[k]];
+    const auto [cx, cy] = cell(l, p.pos[k]);
+    cell_of_[k] = cy * l.nx + cx;
+    ++l.start[cell_of_[k] + 1];
   }
-  std::partial_sum(cell_start_.begin(), cell_start_.end(), cell_start_.begin());
-  cell_items_.resize(n);
-  std::vector<std::int32_t> fill(cell_start_.begin(), cell_start_.end() - 1);
-  for (std::size_t k = 0; k < n; ++k) cell_items_[fill[cell_of_[k]]++] = static_cast<int>(k);
+  for (Level& l : levels_) {
+    std::partial_sum(l.start.begin(), l.start.end(), l.start.begin());
+    l.items.resize(l.count);
+    l.fill.assign(l.start.begin(), l.start.end() - 1);
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    Level& l = levels_[level_of_[k]];
+    l.items[l.fill[cell_of_[k]]++] = static_cast<int>(k);
+  }
+}
+
+// The cell of level l that holds x. A non-finite position (a run blowing up: the stability
+// check reports it) goes to cell 0 rather than to an undefined cell index.
+std::pair<int, int> NeighborSearch::cell(const Level& l, Vec2 x) const {
+  const double fx = (x.x - lo_.x) * l.inv_h, fy = (x.y - lo_.y) * l.inv_h;
+  const int cx = std::isfinite(fx) ? std::clamp(static_cast<int>(fx), 0, l.nx - 1) : 0;
+  const int cy = std::isfinite(fy) ? std::clamp(static_cast<int>(fy), 0, l.ny - 1) : 0;
+  return {cx, cy};
+}
+
+// The partners j of particle i with a larger id within r_i + r_j + skin (not ghost-ghost), in
+// scratch_, in id order.
+void NeighborSearch::find_partners(const ParticleStore& p, std::int32_t i, double skin) {
+  const std::int64_t id_i = p.id[i];
+  const Vec2 xi = p.pos[i];
+  const double ri = p.radius[i];
+  const bool ghost_i = static_cast<std::size_t>(i) >= p.n_owned();
+  scratch_.clear();
+  for (const Level& l : levels_) {
+    if (l.count == 0) continue;
+    // Cells within r_i + R_l + skin of x_i (the own cell and its 8 neighbours on one level).
+    const double reach_l = ri + l.r_max + skin;
+    const auto [x0, y0] = cell(l, {xi.x - reach_l, xi.y - reach_l});
+    const auto [x1, y1] = cell(l, {xi.x + reach_l, xi.y + reach_l});
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const int c = y * l.nx + x;
+        for (int s = l.start[c]; s < l.start[c + 1]; ++s) {
+          const std::int32_t j = l.items[s];
+          if (p.id[j] <= id_i) continue;
+          if (ghost_i && static_cast<std::size_t>(j) >= p.n_owned())
+            continue;  // ghost-ghost pairs belong to other ranks
+          const double reach = ri + p.radius[j] + skin;
+          if (norm2(p.pos[j] - xi) < reach * reach) scratch_.push_back(j);
+        }
+      }
+    }
+  }
+  std::sort(scratch_.begin(), scratch_.end(),
+            [&](std::int32_t a, std::int32_t b) { return p.id[a] < p.id[b]; });
 }
 
 void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, PairList& out) {
@@ -87,48 +210,33 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
     return;
   }
   bin_particles(p, skin);
-  const int nx = nx_, ny = ny_;
-  const std::size_t n_owned = p.n_owned();
   fresh.i.reserve(3 * n);
   fresh.j.reserve(3 * n);
+  std::size_t far = 0;
   for (const std::int32_t i : order_) {
+    find_partners(p, i, skin);
     const std::int64_t id_i = p.id[i];
-    const Vec2 xi = p.pos[i];
-    const double ri = p.radius[i];
-    const int cx = cell_of_[i] % nx, cy = cell_of_[i] / nx;
-    scratch_.clear();
-    for (int y = std::max(0, cy - 1); y <= std::min(ny - 1, cy + 1); ++y) {
-      for (int x = std::max(0, cx - 1); x <= std::min(nx - 1, cx + 1); ++x) {
-        const int c = y * nx + x;
-        for (int s = cell_start_[c]; s < cell_start_[c + 1]; ++s) {
-          const std::int32_t j = cell_items_[s];
-          if (p.id[j] <= id_i) continue;
-          if (static_cast<std::size_t>(i) >= n_owned && static_cast<std::size_t>(j) >= n_owned)
-            continue;  // ghost-ghost pairs belong to other ranks
-          const double reach = ri + p.radius[j] + skin;
-          if (norm2(p.pos[j] - xi) < reach * reach) scratch_.push_back(j);
-        }
-      }
-    }
-    std::sort(scratch_.begin(), scratch_.end(),
-              [&](std::int32_t a, std::int32_t b) { return p.id[a] < p.id[b]; });
     for (const std::int32_t j : scratch_) {
+      far += std::abs(j - i) > kNear ? 1 : 0;
       fresh.i.push_back(i);
       fresh.j.push_back(j);
       fresh.id_i.push_back(id_i);
       fresh.id_j.push_back(p.id[j]);
     }
   }
+  far_fraction_ = fresh.size() ? static_cast<double>(far) / static_cast<double>(fresh.size()) : 0.0;
   merge_history(
       out.width, out.size(),
-      [&](std::size_t k) {
+      [&](std::size_t t) {
+        const std::size_t k = out.entry(t);
         return std::pair{out.id_i[k], out.id_j[k]};
       },
-      out.history, fresh.size(),
+      [&](std::size_t t) { return out.entry(t); }, out.history, fresh.size(),
       [&](std::size_t k) {
         return std::pair{fresh.id_i[k], fresh.id_j[k]};
       },
       fresh.history);
+  if (!id_ordered_) to_storage_order(n, p.n_owned(), fresh);
   fresh.trial = fresh.history;
   out = std::move(fresh);
 }
@@ -173,7 +281,7 @@ void NeighborSearch::build_wall_pairs(const ParticleStore& p, const Walls& walls
       [&](std::size_t k) {
         return std::pair{out.id[k], out.element[k]};
       },
-      out.history, fresh.size(),
+      [](std::size_t k) { return k; }, out.history, fresh.size(),
       [&](std::size_t k) {
         return std::pair{fresh.id[k], fresh.element[k]};
       },

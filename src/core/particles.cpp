@@ -1,9 +1,18 @@
 #include "core/particles.hpp"
 
+#include <atomic>
 #include <numbers>
 #include <stdexcept>
 
 namespace dem2d {
+
+namespace {
+// Layout stamps are unique over all stores, so a stamp never matches another store's.
+std::uint64_t next_layout() {
+  static std::atomic<std::uint64_t> counter{0};
+  return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+}  // namespace
 
 std::size_t ParticleStore::bytes_per_particle() const {
   std::size_t b = 0;
@@ -56,6 +65,7 @@ std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, dou
   force[i] = {};
   torque[i] = 0.0;
   n_owned_ = i + 1;
+  layout_ = next_layout();
   return i;
 }
 
@@ -64,6 +74,7 @@ std::size_t ParticleStore::add_owned(std::size_t n) {
   const std::size_t first = size();
   resize_all(first + n);
   n_owned_ = first + n;
+  layout_ = next_layout();
   return first;
 }
 
@@ -78,11 +89,13 @@ void ParticleStore::remove_if(const std::vector<char>& remove) {
   }
   resize_all(k);
   n_owned_ = k;
+  layout_ = next_layout();
 }
 
 void ParticleStore::permute(const std::vector<std::size_t>& order) {
   clear_ghosts();
   for (FieldBase* f : registry_) f->permute(order);
+  layout_ = next_layout();
 }
 
 void ParticleStore::clear_ghosts() { resize_all(n_owned_); }

@@ -152,6 +152,9 @@ class ParticleStore {
 
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }
+  // Changes whenever the owned particles or their order change (add, remove, permute): what
+  // is derived from the storage order (the neighbour search's id order) is valid while it holds.
+  std::uint64_t layout() const { return layout_; }
   std::size_t n_ghost() const { return size() - n_owned_; }
   const std::vector<FieldBase*>& fields() const { return registry_; }
   std::size_t bytes_per_particle() const;
@@ -177,6 +180,7 @@ class ParticleStore {
  private:
   void resize_all(std::size_t n);
   std::size_t n_owned_ = 0;
+  std::uint64_t layout_ = 0;
   std::unique_ptr<Field<double>> damage_;
   std::unique_ptr<Field<double>> last_contact_;
 };

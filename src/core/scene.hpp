@@ -19,6 +19,8 @@ namespace dem2d {
 enum class ContactModelKind { kHertzMindlin, kThesis, kLinear };
 enum class RollingModelKind { kNone, kConstant, kEpsd };
 enum class IntegratorKind { kVerlet, kIterative };
+// Storage order of the particles (core/spatial_order.hpp): it changes no bit of the physics.
+enum class SpatialSort { kAuto, kAlways, kNever };
 
 struct MaterialSpec {
   std::string name;
@@ -64,6 +66,7 @@ struct RunSpec {
   bool guards_warn = false;
   int sectors_per_rank = 32;  // parallel runs: angular sectors per rank (METIS groups them)
   double repartition_threshold = 1.05;  // parallel runs: max/mean work that triggers a repartition
+  SpatialSort spatial_sort = SpatialSort::kAuto;  // particles in space-filling-curve order
 };
 
 struct ContactSpec {

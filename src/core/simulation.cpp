@@ -33,7 +33,8 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
     : scene_(prepared(scene)),
       domain_(domain ? domain : &serial_domain_),
       walls_(scene_),
-      contacts_(scene_) {
+      contacts_(scene_),
+      sort_policy_(scene_.run.spatial_sort) {
   if (scene_.breakage.present) particles_.enable_damage();
   if (scene_.drum.present) particles_.enable_last_contact();
   if (resume)
@@ -290,20 +291,38 @@ void Simulation::advance_clock() {
 
 void Simulation::rebuild() {
   if (step_ > 0) check_contained();
+  bool sorted = false;
   if (domain_->size() > 1) {
     // Particles that left this rank's region move to their owner with their contact
     // histories; then a new ghost set; the lists take their histories from the records.
     HistoryRecords records = contacts_.records();
     domain_->migrate(particles_, records);
+    sorted = sort_particles();
     domain_->exchange_halo(particles_);
     contacts_.adopt(records);
+  } else {
+    sorted = sort_particles();
   }
   contacts_.build(particles_, walls_, rebuilds_.skin());
+  sort_policy_.built(contacts_.far_fraction(), sorted);
   if (domain_->size() > 1) {
     domain_->report_work(contacts_.particle_work(particles_.n_owned()));
     integrator_->after_rebuild(particles_.n_owned());
   }
   rebuilds_.record(particles_, walls_, time_);
+}
+
+// The owned particles in Hilbert order of cells about one particle wide, when it pays
+// (core/spatial_order.hpp). Their lists are rebuilt next, so nothing indexed by the old order
+// survives: the histories are keyed by ids, every per-particle quantity is a registered field.
+bool Simulation::sort_particles() {
+  const std::size_t n = particles_.n_owned();
+  if (!sort_policy_.due(n)) return false;
+  double area = 0.0;
+  for (std::size_t k = 0; k < n; ++k) area += particles_.radius[k] * particles_.radius[k];
+  const double cell = 2.0 * std::sqrt(area / static_cast<double>(n));  // twice the rms radius
+  particles_.permute(hilbert_order(particles_, cell));
+  return true;
 }
 
 // A particle whose centre is beyond the drum's circle (the polygon's vertices lie on it) has

@@ -30,6 +30,7 @@
 #include "core/particles.hpp"
 #include "core/run_state.hpp"
 #include "core/scene.hpp"
+#include "core/spatial_order.hpp"
 #include "core/state_backup.hpp"
 #include "core/time_scales.hpp"
 #include "core/walls.hpp"
@@ -118,6 +119,8 @@ class Simulation final : private StepStages {
   const PairList& pairs() const { return contacts_.pairs(); }
   const WallPairList& wall_pairs() const { return contacts_.wall_pairs(); }
   std::int64_t neighbor_builds() const { return builds_before_ + contacts_.builds(); }
+  // Times this rank put its particles in spatial order (core/spatial_order.hpp).
+  std::int64_t spatial_sorts() const { return sort_policy_.sorts(); }
   std::int64_t passes_total() const { return integrator_->passes().total; }
   std::int64_t unconverged_steps() const { return integrator_->passes().unconverged_steps; }
   int last_passes() const { return integrator_->passes().last; }
@@ -154,6 +157,8 @@ class Simulation final : private StepStages {
   void set_up_lists();
   // A particle outside the drum: UnstableError naming it (collective, at rebuilds).
   void check_contained();
+  // Put the owned particles in spatial order if the policy says so; true if it did.
+  bool sort_particles();
   // The resuming constructor's part: particles, histories and state from the checkpoint.
   void load_particles(const Resumption& resume);
   void resume_from(const Resumption& resume);
@@ -180,6 +185,7 @@ class Simulation final : private StepStages {
   ParticleStore particles_;
   Walls walls_;
   ContactEngine contacts_;
+  SortPolicy sort_policy_;
   TimeScales scales_;
   double dt_ = 0.0;
   double halo_width_ = 0.0;

@@ -372,10 +372,11 @@ void flatten(const toml::node& node, const std::string& key,
 }
 
 // Keys a restart may change: where and how often output goes, how long the run is, its title
-// and how it is spread over ranks.
+// and how it is spread over ranks and stored.
 bool may_change(const std::string& key) {
   return key.starts_with("output.") || key == "run.duration" || key == "title" ||
-         key == "run.sectors_per_rank" || key == "run.repartition_threshold";
+         key == "run.sectors_per_rank" || key == "run.repartition_threshold" ||
+         key == "run.spatial_sort";
 }
 
 }  // namespace

@@ -59,6 +59,11 @@ inline constexpr std::array kIntegrators = {
     Choice<IntegratorKind>{"verlet", IntegratorKind::kVerlet},
     Choice<IntegratorKind>{"iterative", IntegratorKind::kIterative},
 };
+inline constexpr std::array kSpatialSorts = {
+    Choice<SpatialSort>{"auto", SpatialSort::kAuto},
+    Choice<SpatialSort>{"always", SpatialSort::kAlways},
+    Choice<SpatialSort>{"never", SpatialSort::kNever},
+};
 inline constexpr std::array kGuardModes = {
     Choice<bool>{"stop", false},
     Choice<bool>{"warn", true},
@@ -367,6 +372,15 @@ inline constexpr Key<RunSpec> kRunKeys[] = {
             "owned particles + listed pairs) exceeds this (at most every 10 neighbour "
             "rebuilds). Waterfall at 2 ranks, 5 s: 1.2 leaves a mean imbalance of 1.072 (5 "
             "partitions), 1.1: 1.028 (7), 1.05: 1.018 (19), 1.02: 1.010 (59)"},
+    {.name = "spatial_sort",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kSpatialSorts>,
+     .field = choice<&RunSpec::spatial_sort, kSpatialSorts>(),
+     .doc = "storage order of the particles, for speed only (no bit of the physics changes): "
+            "`\"auto\"` sorts them along a space-filling curve at a neighbour rebuild when a "
+            "rank owns at least 250 000 of them and over 30 % of their pairs join particles far "
+            "apart in memory (ids spatially random); `\"always\"` at every rebuild; "
+            "`\"never\"` keeps them in id order"},
 };
 
 inline constexpr Key<ContactSpec> kContactKeys[] = {

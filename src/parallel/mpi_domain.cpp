@@ -32,13 +32,14 @@ class CommTimer {
   double start_;
 };
 
-// Owned particles in id order (the serial order, whatever ranks they came from).
-void sort_owned_by_id(ParticleStore& p) {
-  if (std::is_sorted(p.id.data(), p.id.data() + p.n_owned())) return;
+// Owned particles [first, n_owned) in id order.
+void sort_owned_by_id(ParticleStore& p, std::size_t first = 0) {
+  const std::int64_t* id = p.id.data();
+  if (std::is_sorted(id + first, id + p.n_owned())) return;
   std::vector<std::size_t> order(p.n_owned());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return p.id[a] < p.id[b]; });
+  std::sort(order.begin() + static_cast<std::ptrdiff_t>(first), order.end(),
+            [&](std::size_t a, std::size_t b) { return id[a] < id[b]; });
   p.permute(order);
 }
 
@@ -254,8 +255,10 @@ void MpiDomain::transport(const Plan& plan, const MessageLayout& layout,
 // Migration moves the particles that left this rank's region, with every registered field and
 // the contact histories that involve them, through the halo's plan-and-transport: a plan per
 // migration (make_plan), one message per peer (the particles field by field, then their
-// records), the arrivals appended in ascending rank order and the owned particles put back in
-// id order, so the store is the same whatever rank a particle came from.
+// records), the arrivals appended in ascending rank order and put in id order, so the store is
+// the same whatever rank a particle came from: a store in id order stays in id order; one in
+// spatial order (core/spatial_order.hpp) keeps the order of the particles that stay, with the
+// arrivals after them (the next sort puts them in place).
 void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   CommTimer timer(stats_.comm_seconds);
   p.clear_ghosts();
@@ -271,9 +274,11 @@ void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   transport(plan, {0, p.bytes_per_particle(), histories.record_bytes()}, send_buffers_,
             recv_buffers_);
   particle_work_.clear();  // indexed by the old store order
+  const bool id_order = std::is_sorted(p.id.data(), p.id.data() + p.n_owned());
   p.remove_if(leaving);
+  const std::size_t staying = p.n_owned();
   unpack_migration(p, histories, plan);
-  sort_owned_by_id(p);
+  sort_owned_by_id(p, id_order ? 0 : staying);
   histories.sort_unique();
 
   const std::int64_t total = sum(static_cast<std::int64_t>(p.n_owned()));

@@ -35,10 +35,37 @@ std::vector<IdPair> brute_force_wall_pairs(const ParticleStore& p, const Walls& 
   return out;
 }
 
+// The listed pairs in key order (the list itself is in storage order when the particles are
+// not stored in id order).
 std::vector<IdPair> listed_pairs(const PairList& pl) {
   std::vector<IdPair> out;
-  for (std::size_t k = 0; k < pl.size(); ++k) out.emplace_back(pl.id_i[k], pl.id_j[k]);
+  for (std::size_t t = 0; t < pl.size(); ++t)
+    out.emplace_back(pl.id_i[pl.entry(t)], pl.id_j[pl.entry(t)]);
   return out;
+}
+
+// A list in storage order: entries by their lower local index, and every owned particle's
+// force records naming each of its pairs once, in the order of the partners' ids.
+void expect_storage_order(const ParticleStore& p, const PairList& pl) {
+  ASSERT_FALSE(pl.canonical());
+  for (std::size_t k = 1; k < pl.size(); ++k)
+    EXPECT_LE(std::min(pl.i[k - 1], pl.j[k - 1]), std::min(pl.i[k], pl.j[k]));
+  ASSERT_EQ(pl.record_start.size(), p.n_owned() + 1);
+  std::size_t records = 0;
+  for (std::size_t q = 0; q < p.n_owned(); ++q) {
+    std::vector<std::int64_t> partners;
+    for (std::int32_t s = pl.record_start[q]; s < pl.record_start[q + 1]; ++s) {
+      const std::int32_t r = pl.records[s];
+      const std::size_t k = static_cast<std::size_t>(r / 2);
+      const std::int32_t self = r % 2 ? pl.j[k] : pl.i[k];
+      const std::int32_t other = r % 2 ? pl.i[k] : pl.j[k];
+      EXPECT_EQ(static_cast<std::size_t>(self), q);
+      partners.push_back(p.id[other]);
+      ++records;
+    }
+    EXPECT_TRUE(std::is_sorted(partners.begin(), partners.end())) << "particle " << p.id[q];
+  }
+  EXPECT_EQ(records, 2 * pl.size());  // no ghosts here: both ends of every pair are owned
 }
 
 std::vector<IdPair> listed_wall_pairs(const WallPairList& wl) {
@@ -133,6 +160,11 @@ void check_config(const Config& c) {
     EXPECT_EQ(p.id[pairs.j[k]], pairs.id_j[k]);
   }
   EXPECT_EQ(pairs.history.size(), pairs.size() * pairs.width);  // the declared slots per pair
+  if (c.shuffled_ids) {
+    expect_storage_order(p, pairs);
+  } else {
+    EXPECT_TRUE(pairs.canonical());
+  }
 
   std::vector<IdPair> got_w = listed_wall_pairs(wall_pairs);
   EXPECT_TRUE(std::is_sorted(got_w.begin(), got_w.end()));
@@ -146,11 +178,12 @@ void check_config(const Config& c) {
 }
 
 TEST(Neighbors, CandidatesEqualBruteForceForRandomConfigurations) {
-  for (double ratio : {1.0, 10.0})
+  for (double ratio : {1.0, 10.0, 400.0})
     for (Shell shell : {Shell::kNone, Shell::kCircle, Shell::kPolygon})
       for (double skin : {0.0, 0.02}) check_config({ratio, shell, skin, false, false});
   check_config({10.0, Shell::kPolygon, 0.02, true, false});
   check_config({1.0, Shell::kNone, 0.01, true, true});
+  check_config({400.0, Shell::kCircle, 0.02, true, false});
   check_config({10.0, Shell::kNone, 0.0, false, true});
 }
 

@@ -1,0 +1,173 @@
+// Storage order (core/spatial_order.hpp): the Hilbert curve visits every cell once, stepping to
+// an adjacent cell each time; the sorted store is in curve order; and a run whose particles are
+// re-sorted at every rebuild ends with every field of every particle bit for bit as the run kept
+// in id order: Verlet and the iterative scheme, a 10:1 size range (several search levels), and
+// breakage, feed and sieve changing the population.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "core/simulation.hpp"
+#include "core/spatial_order.hpp"
+#include "support/thesis.hpp"
+
+namespace dem2d {
+namespace {
+
+using testing_support::thesis_drum_scene;
+
+TEST(SpatialOrder, HilbertCurveVisitsEveryCellOnceByAdjacentSteps) {
+  for (int bits = 1; bits <= 6; ++bits) {
+    const std::uint32_t side = std::uint32_t{1} << bits;
+    std::map<std::uint64_t, std::pair<int, int>> at;
+    for (std::uint32_t x = 0; x < side; ++x)
+      for (std::uint32_t y = 0; y < side; ++y)
+        at[hilbert_index(x, y, bits)] = {static_cast<int>(x), static_cast<int>(y)};
+    ASSERT_EQ(at.size(), static_cast<std::size_t>(side) * side) << "bits " << bits;
+    EXPECT_EQ(at.begin()->first, 0u);
+    EXPECT_EQ(at.rbegin()->first, static_cast<std::uint64_t>(side) * side - 1);
+    std::pair<int, int> prev = at.begin()->second;
+    for (const auto& [d, xy] : at) {
+      if (d == 0) continue;
+      EXPECT_EQ(std::abs(xy.first - prev.first) + std::abs(xy.second - prev.second), 1)
+          << "bits " << bits << ", step " << d;
+      prev = xy;
+    }
+  }
+}
+
+// Every field of every particle, bit for bit, matched by id.
+void expect_same_particles(const Simulation& a, const Simulation& b) {
+  const ParticleStore& p = a.particles();
+  const ParticleStore& q = b.particles();
+  ASSERT_EQ(p.n_owned(), q.n_owned());
+  std::map<std::int64_t, std::size_t> in_q;
+  for (std::size_t k = 0; k < q.n_owned(); ++k) in_q[q.id[k]] = k;
+  for (std::size_t f = 0; f < p.fields().size(); ++f) {
+    const FieldBase& fa = *p.fields()[f];
+    const FieldBase& fb = *q.fields()[f];
+    ASSERT_EQ(fa.name(), fb.name());
+    const std::size_t w = fa.bytes_per_item();
+    std::vector<std::byte> x(w), y(w);
+    int differ = 0;
+    for (std::size_t m = 0; m < p.n_owned(); ++m) {
+      ASSERT_TRUE(in_q.contains(p.id[m])) << "particle " << p.id[m];
+      fa.pack(m, x.data());
+      fb.pack(in_q[p.id[m]], y.data());
+      differ += std::memcmp(x.data(), y.data(), w) != 0;
+    }
+    EXPECT_EQ(differ, 0) << "field " << fa.name();
+  }
+}
+
+// The storage order is far from id order: the fraction of neighbours in storage that are not
+// neighbours in id.
+double out_of_id_order(const ParticleStore& p) {
+  std::size_t out = 0;
+  for (std::size_t k = 1; k < p.n_owned(); ++k) out += p.id[k] < p.id[k - 1];
+  return static_cast<double>(out) / static_cast<double>(p.n_owned());
+}
+
+// Runs the scene kept in id order and re-sorted at every rebuild, compares at the end.
+void expect_sorting_changes_nothing(Scene scene, double t_end) {
+  scene.run.spatial_sort = SpatialSort::kNever;
+  Simulation plain(scene);
+  scene.run.spatial_sort = SpatialSort::kAlways;
+  Simulation sorted(scene);
+  plain.run_until(t_end);
+  sorted.run_until(t_end);
+  EXPECT_EQ(plain.spatial_sorts(), 0);
+  EXPECT_GE(sorted.spatial_sorts(), 3) << "the test should sort several times";
+  EXPECT_GT(out_of_id_order(sorted.particles()), 0.1) << "the sorted store should be reordered";
+  EXPECT_GT(plain.last_totals().contacts, 0);
+  EXPECT_EQ(sorted.last_totals().contacts, plain.last_totals().contacts);
+  EXPECT_EQ(sorted.neighbor_builds(), plain.neighbor_builds());
+  expect_same_particles(plain, sorted);
+}
+
+TEST(SpatialOrder, SortingChangesNoBitOfAVerletDrum) {
+  expect_sorting_changes_nothing(thesis_drum_scene(120, 1.8, 16, 0.1), 0.25);
+}
+
+TEST(SpatialOrder, SortingChangesNoBitOfTheIterativeScheme) {
+  Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
+  s.run.integrator = IntegratorKind::kIterative;
+  s.run.dt_auto = false;
+  s.run.dt = 2e-5;
+  expect_sorting_changes_nothing(s, 0.2);
+}
+
+// Balls of 2-20 mm radius (four search levels) stirred by an 8-sided drum.
+TEST(SpatialOrder, SortingChangesNoBitWithATenToOneSizeRange) {
+  Scene s = thesis_drum_scene(10, 3.0, 8, 0.0);
+  s.drum.radius = 0.4;
+  s.fills.front().count = 200;
+  s.fills.front().region = FillRegion::kFull;
+  s.fills.front().radius_min = 0.002;
+  s.fills.front().radius_max = 0.02;
+  Simulation probe(s);
+  ASSERT_EQ(probe.particles().n_owned(), 200u);
+  expect_sorting_changes_nothing(s, 0.4);
+}
+
+// Ore breaks, is fed and leaves through the sieve: the population changes between sorts.
+TEST(SpatialOrder, SortingChangesNoBitWhileOreBreaksIsFedAndSieved) {
+  Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
+  MaterialSpec ore = testing_support::thesis_steel();
+  ore.name = "ore";
+  ore.density = 4800.0;
+  s.materials.push_back(ore);
+  FillSpec f = s.fills.front();
+  f.material = "ore";
+  f.count = 40;
+  f.radius_min = f.radius_max = 0.06;
+  s.fills.push_back(f);
+  s.breakage = {.present = true,
+                .material = "ore",
+                .minimum_energy = 0.01,
+                .strength = 5.0,
+                .minimum_radius = 0.035};
+  s.feed = {
+      .present = true, .material = "ore", .period = 0.02, .radius_min = 0.04, .radius_max = 0.05};
+  s.sieve = {.present = true,
+             .material = "ore",
+             .box_min = {-2.5, -2.5},
+             .box_max = {2.5, 2.5},
+             .aperture = 0.03};
+  s.run.spatial_sort = SpatialSort::kAlways;
+  Simulation sorted(s);
+  sorted.run_until(0.4);
+  const GrindingTotals& t = sorted.grinding()->totals();
+  EXPECT_GT(t.breakages, 0);
+  EXPECT_GT(t.fed_count, 0);
+  EXPECT_GT(t.discharged_count, 0);
+  expect_sorting_changes_nothing(s, 0.4);
+}
+
+// Auto: a small scene is never sorted; a large one when most of its pairs are far apart in
+// storage, and again when they have become so after a sort.
+TEST(SpatialOrder, AutoSortsLargeScenesWhosePairsAreFarApartInStorage) {
+  Scene small = thesis_drum_scene(240, 1.8, 16, 0.1);
+  Simulation a(small);
+  a.run_until(0.05);
+  EXPECT_EQ(a.spatial_sorts(), 0);
+
+  SortPolicy policy;
+  const std::size_t big = SortPolicy::kMinParticles;
+  EXPECT_FALSE(policy.due(big));  // nothing known about the lists yet
+  policy.built(0.9, false);
+  EXPECT_FALSE(policy.due(big - 1));
+  EXPECT_TRUE(policy.due(big));
+  policy.built(0.02, true);
+  EXPECT_FALSE(policy.due(big));
+  policy.built(0.5, false);
+  EXPECT_TRUE(policy.due(big));
+  EXPECT_EQ(policy.sorts(), 1);
+}
+
+}  // namespace
+}  // namespace dem2d
