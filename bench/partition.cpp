@@ -1,27 +1,28 @@
 // partition: the angular-sector partition in partition-only mode (no stepping): load balance and
 // halo size of the METIS-weighted sector partition against equal angles, for a settled charge
-// of 30 000 spheres and a 300 000-sphere charge, at 2 .. 64 ranks.
+// of 30 000 spheres and charges of 300 000 and 1 000 000 spheres, at 2 .. 256 ranks.
 //
 // Charges (drum centre (0, 0)).
 // (a) The settled 30 000-sphere charge of bench/throughput (bench/settled_drum.hpp), read from
 //     bench/results/cache/settled_drum_30000.csv (x, y, radius, vx, vy, spin; drum radius
 //     2.5 m). If the file is missing the program says how to make it and exits 1.
-// (b) 300 000 spheres in a drum of radius 2.5 sqrt(10) m, built without simulation by tiling
-//     the settled packing: a rectangular patch is cut from the interior of charge (a):
-//     |x| < 0.64 R, from 0.02 R above the drum shell at x = 0.64 R up to 0.05 R below the bed
-//     surface (the 99th percentile of y) - about half the charge. Copies of the patch, placed
-//     side by side with the patch's width and height as periods, cover the big drum; a copy's
-//     particle is kept if it lies inside the drum (|x| + r <= R') and overlaps no particle kept
-//     before it by more than 0.1 mm (the seams between copies cut through the packing: a
-//     kept-first rule on a cell grid removes the seam overlaps; the settled contacts overlap by
-//     micrometres and are kept). The 300 000 lowest of the kept particles (by y, then x) are the
-//     charge: a circular segment at the bottom of the drum with a flat top, the shape of charge
-//     (a) scaled by sqrt(10) (the program prints the two surface heights; the seams' gaps make
-//     the packing slightly looser, so the surface sits slightly higher). Area fraction of the
-//     bed ~0.77 as in (a).
+// (b), (c) N = 300 000 and 1 000 000 spheres in a drum of radius 2.5 sqrt(N / 30 000) m
+//     (7.91 m and 14.43 m), built without simulation by tiling the settled packing: a
+//     rectangular patch is cut from the interior of charge (a): |x| < 0.64 R, from 0.02 R above
+//     the drum shell at x = 0.64 R up to 0.05 R below the bed surface (the 99th percentile of
+//     y) - about half the charge. Copies of the patch, placed side by side with the patch's
+//     width and height as periods, cover the big drum; a copy's particle is kept if it lies
+//     inside the drum (|x| + r <= R') and overlaps no particle kept before it by more than
+//     0.1 mm (the seams between copies cut through the packing: a kept-first rule on a cell
+//     grid removes the seam overlaps; the settled contacts overlap by micrometres and are
+//     kept). The N lowest of the kept particles (by y, then x) are the charge: a circular
+//     segment at the bottom of the drum with a flat top, the shape of charge (a) scaled by
+//     sqrt(N / 30 000) (the program prints the two surface heights; the seams' gaps make the
+//     packing slightly looser, so the surface sits slightly higher). Area fraction of the bed
+//     ~0.77 as in (a).
 //
-// Per configuration (charge, work variant, nranks in {2, 4, 8, 16, 32, 64}, sectors per rank
-// spr in {16, 24, 32, 48, 64, 96, 128}; n = nranks spr sectors):
+// Per configuration (charge, work variant, nranks in {2, 4, ..., 256}, sectors per rank
+// spr in {16, 24, 32, 48, 64, 96, 128}; n = nranks spr sectors, up to 32 768):
 //  - work per sector: "particles": particles per sector (sector_of, the ownership rule);
 //    "contacts" (charge (a) only): pairs with |x_i - x_j| < r_i + r_j + skin, skin =
 //    0.4 r_min = 2.4 mm (cell grid), each pair counting 1/2 in the sector of each particle;
@@ -33,11 +34,17 @@
 //  - halo: the ghosts of rank k are the particles owned by another rank whose distance to k's
 //    wedge (distance_to_part) is below h. For each particle only the ranks owning a sector
 //    within the angle asin(h / |x|) (+- one sector) can qualify (all ranks if |x| <= h): O(N)
-//    per partition, no O(N^2). Reported: mean and max ghosts per rank and ghosts / owned
-//    (total ghosts over N).
-// Output: a table (16 and 64 sectors per rank, and the fewest sectors per rank with which the
-// METIS partition reaches 5 %), bench/results/partition.csv (every configuration) and
-// bench/results/partition.png (post/plot_partition.py through std::system; --no-plot skips).
+//    per partition, no O(N^2). Reported: mean and max ghosts per rank, ghosts / owned (total
+//    ghosts over N), the largest ghosts / owned of one rank (ranks owning particles) and how
+//    many ranks hold more ghosts than half their owned particles, and the narrowest wedge (an
+//    arc's angle, and its width at the shell) of the ranks that own particles.
+// The whole sweep, 448 partitions, takes about 30 s of CPU (2026-11-26; the 1e6 charge's 112
+// about 60 % of it), so no charge needs a shorter one.
+// Output: a table (imbalance at 16, 32 and 64 sectors per rank, the fewest sectors per rank
+// with which the METIS partition reaches 5 %, the halo at 32, the default), the rank counts
+// from which the halo passes half the owned particles, bench/results/partition.csv (every
+// configuration) and bench/results/partition.png (post/plot_partition.py through std::system;
+// --no-plot skips).
 //
 //   partition [--no-plot] [--results DIR]
 #include <algorithm>
@@ -65,10 +72,11 @@ constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m (bench/settled_dr
 constexpr double kSkin = 0.4 * kRadiusMin;
 constexpr double kHalo = 2.0 * kRadiusMax + kSkin;
 constexpr double kRefDrum = 2.5;
-constexpr std::int64_t kBigN = 300000;
 constexpr double kTarget = 1.05;
-const std::vector<int> kRanks{2, 4, 8, 16, 32, 64};
+constexpr double kHaloLimit = 0.5;  // "the halo passes half the owned particles"
+const std::vector<int> kRanks{2, 4, 8, 16, 32, 64, 128, 256};
 const std::vector<int> kSectorsPerRank{16, 24, 32, 48, 64, 96, 128};
+constexpr int kDefaultSpr = 32;  // DecompositionOptions
 
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -162,8 +170,8 @@ double percentile_y(const Charge& c, double q) {
   return y[k];
 }
 
-// Charge (b): tiles of a patch of charge (a) (header).
-Charge tile_charge(const Charge& a, std::int64_t n_target) {
+// Charges (b) and (c): tiles of a patch of charge (a) (header).
+Charge tile_charge(const Charge& a, std::int64_t n_target, const std::string& name) {
   const double R = a.drum_radius, scale = std::sqrt(static_cast<double>(n_target) / a.size());
   const double surface = percentile_y(a, 0.99);
   const double half = 0.64 * R;
@@ -174,7 +182,7 @@ Charge tile_charge(const Charge& a, std::int64_t n_target) {
     if (std::abs(a.x[i].x) < half && a.x[i].y >= y0 && a.x[i].y < y1) patch.push_back(i);
 
   Charge b;
-  b.name = "300k";
+  b.name = name;
   b.drum_radius = R * scale;
   const double Rb = b.drum_radius;
   const double top = surface * scale + 0.1 * Rb;  // generous: trimmed to n_target below
@@ -219,12 +227,12 @@ Charge tile_charge(const Charge& a, std::int64_t n_target) {
     b.r.push_back(cand_r[i]);
   }
   std::printf(
-      "(b) tiled: patch |x| < %.3f m, y in [%.3f, %.3f) m (%zu particles, of %zu), %d x %d "
-      "copies, %zu candidates, %zu after the seam overlaps; surface y = %.3f m (sqrt(10) x the "
-      "30k surface %.3f m = %.3f m)\n",
-      half, y0, y1, patch.size(), a.size(), cols, rows, cand.size(),
-      static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), b.x.back().y, surface,
-      surface * scale);
+      "%s tiled in a drum of radius %.3f m: patch |x| < %.3f m, y in [%.3f, %.3f) m (%zu "
+      "particles, of %zu), %d x %d copies, %zu candidates, %zu after the seam overlaps; surface "
+      "y = %.3f m (%.3f x the 30k surface %.3f m = %.3f m)\n",
+      name.c_str(), Rb, half, y0, y1, patch.size(), a.size(), cols, rows, cand.size(),
+      static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), b.x.back().y, scale,
+      surface, surface * scale);
   return b;
 }
 
@@ -332,7 +340,33 @@ struct Row {
   int nranks = 0, spr = 0;
   double imbalance = 0.0, ghosts_mean = 0.0, ghost_ratio = 0.0, ms = 0.0;
   std::int64_t ghosts_max = 0, owned_min = 0, owned_max = 0;
+  double rank_ratio_max = 0.0;   // max over ranks owning particles of ghosts / owned
+  int ranks_over_limit = 0;      // ranks owning particles with ghosts > kHaloLimit x owned
+  double wedge_min_deg = 0.0;    // narrowest arc of a rank owning particles, degrees
+  double wedge_min_shell = 0.0;  // its width at the drum shell, m
 };
+
+// The halo figures of a row from the per-rank owned and ghost counts.
+void fill_halo(Row& r, const Halo& h, const SectorPartition& p, double drum_radius) {
+  std::int64_t total_ghosts = 0;
+  for (std::int64_t g : h.ghosts) total_ghosts += g;
+  r.ghosts_mean = static_cast<double>(total_ghosts) / r.nranks;
+  r.ghosts_max = *std::max_element(h.ghosts.begin(), h.ghosts.end());
+  r.ghost_ratio = static_cast<double>(total_ghosts) / static_cast<double>(r.n_particles);
+  r.owned_min = *std::min_element(h.owned.begin(), h.owned.end());
+  r.owned_max = *std::max_element(h.owned.begin(), h.owned.end());
+  int narrowest = p.n_sectors;
+  for (std::size_t k = 0; k < h.owned.size(); ++k) {
+    const auto owned = static_cast<double>(h.owned[k]), ghosts = static_cast<double>(h.ghosts[k]);
+    if (h.owned[k] == 0) continue;
+    if (ghosts > kHaloLimit * owned) ++r.ranks_over_limit;
+    r.rank_ratio_max = std::max(r.rank_ratio_max, ghosts / owned);
+    narrowest = std::min(narrowest, p.arcs[k].count);
+  }
+  const double angle = narrowest * dem2d::kTwoPi / p.n_sectors;
+  r.wedge_min_deg = angle * 360.0 / dem2d::kTwoPi;
+  r.wedge_min_shell = angle * drum_radius;
+}
 
 struct Options {
   bool plot = true;
@@ -364,6 +398,81 @@ const Row* find(const std::vector<Row>& rows, const std::string& charge, const s
   return nullptr;
 }
 
+struct Case {
+  const Charge* charge;
+  std::string work;
+  std::vector<double> weight;  // per particle
+};
+
+// The table: imbalance at 16, 32 and 64 sectors per rank, the fewest sectors per rank
+// reaching 5 %, and the halo at the default 32.
+void print_table(const std::vector<Case>& cases, const std::vector<Row>& rows) {
+  std::printf(
+      "%-4s %-9s %5s | %7s %7s %7s %7s %7s | %5s | %8s %7s %6s %7s %4s %6s | %8s %6s %7s | %s\n",
+      "N", "work", "ranks", "metis16", "equal16", "metis32", "metis64", "equal64", "spr5%",
+      "ghosts", "max", "g/own", "rankmax", ">50%", "wedge", "eq ghost", "g/own", "rankmax",
+      "metis32 method");
+  for (const Case& cs : cases) {
+    for (int nranks : kRanks) {
+      const std::string& cn = cs.charge->name;
+      const Row* m16 = find(rows, cn, cs.work, nranks, 16, "metis");
+      const Row* e16 = find(rows, cn, cs.work, nranks, 16, "equal-angle");
+      const Row* m32 = find(rows, cn, cs.work, nranks, kDefaultSpr, "metis");
+      const Row* e32 = find(rows, cn, cs.work, nranks, kDefaultSpr, "equal-angle");
+      const Row* m64 = find(rows, cn, cs.work, nranks, 64, "metis");
+      const Row* e64 = find(rows, cn, cs.work, nranks, 64, "equal-angle");
+      char more[16];  // (">" + std::to_string: a false -Wrestrict in GCC 12)
+      std::snprintf(more, sizeof more, ">%d", kSectorsPerRank.back());
+      std::string spr5 = more;
+      for (int spr : kSectorsPerRank) {
+        const Row* r = find(rows, cn, cs.work, nranks, spr, "metis");
+        if (r && r->imbalance <= kTarget) {
+          spr5 = std::to_string(spr);
+          break;
+        }
+      }
+      std::printf(
+          "%-4s %-9s %5d | %7.4f %7.4f %7.4f %7.4f %7.4f | %5s | %8.1f %7lld %6.3f %7.3f %4d "
+          "%6.1f | %8.1f %6.3f %7.3f | %s\n",
+          cn.c_str(), cs.work.c_str(), nranks, m16->imbalance, e16->imbalance, m32->imbalance,
+          m64->imbalance, e64->imbalance, spr5.c_str(), m32->ghosts_mean,
+          static_cast<long long>(m32->ghosts_max), m32->ghost_ratio, m32->rank_ratio_max,
+          m32->ranks_over_limit, 1e3 * m32->wedge_min_shell, e32->ghosts_mean, e32->ghost_ratio,
+          e32->rank_ratio_max, m32->detail.c_str());
+    }
+  }
+  std::printf(
+      "   metisS / equalS: imbalance (max rank work / mean) at S sectors per rank; spr5%%: fewest "
+      "sectors per rank\n"
+      "   (of 16 24 32 48 64 96 128) with METIS imbalance <= %.2f. At %d sectors per rank (the "
+      "default): ghosts, max:\n"
+      "   mean and max ghosts per rank; g/own: all ghosts / N; rankmax: the largest ghosts / "
+      "owned of one rank;\n"
+      "   >50%%: ranks holding more ghosts than half their owned particles; wedge: the narrowest "
+      "rank's arc at the\n"
+      "   shell, mm (halo width %.1f mm); eq ghost, g/own, rankmax: the same for equal angles\n",
+      kTarget, kDefaultSpr, 1e3 * kHalo);
+}
+
+// The rank counts from which the halo passes half the owned particles (32 sectors per rank).
+void print_halo_limits(const std::vector<Case>& cases, const std::vector<Row>& rows) {
+  std::printf("\nhalo past %.0f %% of the owned particles, at %d sectors per rank:\n",
+              100.0 * kHaloLimit, kDefaultSpr);
+  for (const Case& cs : cases) {
+    if (cs.work != "particles") continue;
+    for (const std::string method : {"metis", "equal-angle"}) {
+      std::string all = "never", one = "never";
+      for (auto k = kRanks.rbegin(); k != kRanks.rend(); ++k) {
+        const Row* r = find(rows, cs.charge->name, cs.work, *k, kDefaultSpr, method);
+        if (r->ghost_ratio > kHaloLimit) all = "from " + std::to_string(*k) + " ranks";
+        if (r->rank_ratio_max > kHaloLimit) one = "from " + std::to_string(*k) + " ranks";
+      }
+      std::printf("   %-4s %-11s all ghosts / N: %-16s the worst rank: %s\n",
+                  cs.charge->name.c_str(), method.c_str(), all.c_str(), one.c_str());
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -385,8 +494,11 @@ int main(int argc, char** argv) {
       "h = 2 r_max + skin = %.1f mm\n",
       1e3 * kHalo);
   std::printf("(a) %zu particles from %s\n", small.size(), cache.c_str());
-  const auto t_tile = Clock::now();
-  const Charge big = tile_charge(small, kBigN);
+  auto t_tile = Clock::now();
+  const Charge big = tile_charge(small, 300000, "300k");
+  std::printf("    (%.2f s)\n", seconds_since(t_tile));
+  t_tile = Clock::now();
+  const Charge huge = tile_charge(small, 1000000, "1M");
   std::printf("    (%.2f s)\n", seconds_since(t_tile));
 
   std::int64_t pairs = 0;
@@ -395,11 +507,6 @@ int main(int argc, char** argv) {
               1e3 * kSkin, static_cast<long long>(pairs),
               2.0 * static_cast<double>(pairs) / static_cast<double>(small.size()));
 
-  struct Case {
-    const Charge* charge;
-    std::string work;
-    std::vector<double> weight;  // per particle
-  };
   std::vector<Case> cases;
   cases.push_back({&small, "particles", std::vector<double>(small.size(), 1.0)});
   {
@@ -408,11 +515,13 @@ int main(int argc, char** argv) {
     cases.push_back({&small, "contacts", w});
   }
   cases.push_back({&big, "particles", std::vector<double>(big.size(), 1.0)});
+  cases.push_back({&huge, "particles", std::vector<double>(huge.size(), 1.0)});
 
   std::vector<Row> rows;
   for (const Case& cs : cases) {
     const Charge& c = *cs.charge;
     const Polar pol = polar_of(c);
+    const auto t_case = Clock::now();
     for (int spr : kSectorsPerRank) {
       for (int nranks : kRanks) {
         const int n = spr * nranks;
@@ -443,70 +552,36 @@ int main(int argc, char** argv) {
           r.spr = spr;
           r.imbalance = dem2d::imbalance(work, p);
           r.ms = ms;
-          std::int64_t total_ghosts = 0;
-          for (std::int64_t g : h.ghosts) total_ghosts += g;
-          r.ghosts_mean = static_cast<double>(total_ghosts) / nranks;
-          r.ghosts_max = *std::max_element(h.ghosts.begin(), h.ghosts.end());
-          r.ghost_ratio = static_cast<double>(total_ghosts) / static_cast<double>(c.size());
-          r.owned_min = *std::min_element(h.owned.begin(), h.owned.end());
-          r.owned_max = *std::max_element(h.owned.begin(), h.owned.end());
+          fill_halo(r, h, p, c.drum_radius);
           rows.push_back(r);
         }
       }
     }
+    std::printf("%s, %s: %zu partitions in %.1f s\n", c.name.c_str(), cs.work.c_str(),
+                2 * kSectorsPerRank.size() * kRanks.size(), seconds_since(t_case));
+    std::fflush(stdout);
   }
+  std::printf("\n");
 
-  // Table: 16 and 64 sectors per rank, and the fewest sectors per rank reaching 5 %.
-  std::printf("%-5s %-9s %5s | %8s %8s %8s %8s | %5s | %8s %7s %7s %7s | %8s %7s | %s\n", "N",
-              "work", "ranks", "metis16", "equal16", "metis64", "equal64", "spr5%", "ghosts", "max",
-              "g/own", "(64)", "eq ghost", "g/own", "metis16 method");
-  for (const Case& cs : cases) {
-    for (int nranks : kRanks) {
-      const std::string& cn = cs.charge->name;
-      const Row* m16 = find(rows, cn, cs.work, nranks, 16, "metis");
-      const Row* e16 = find(rows, cn, cs.work, nranks, 16, "equal-angle");
-      const Row* m64 = find(rows, cn, cs.work, nranks, 64, "metis");
-      const Row* e64 = find(rows, cn, cs.work, nranks, 64, "equal-angle");
-      std::string spr5 = ">128";
-      for (int spr : kSectorsPerRank) {
-        const Row* r = find(rows, cn, cs.work, nranks, spr, "metis");
-        if (r && r->imbalance <= kTarget) {
-          spr5 = std::to_string(spr);
-          break;
-        }
-      }
-      std::printf(
-          "%-5s %-9s %5d | %8.4f %8.4f %8.4f %8.4f | %5s | %8.1f %7lld %7.4f %7.4f | %8.1f %7.4f "
-          "| %s\n",
-          cn.c_str(), cs.work.c_str(), nranks, m16->imbalance, e16->imbalance, m64->imbalance,
-          e64->imbalance, spr5.c_str(), m16->ghosts_mean, static_cast<long long>(m16->ghosts_max),
-          m16->ghost_ratio, m64->ghost_ratio, e16->ghosts_mean, e16->ghost_ratio,
-          m16->detail.c_str());
-    }
-  }
-  std::printf(
-      "   metisS / equalS: imbalance (max rank work / mean) at S sectors per rank; spr5%%: fewest "
-      "sectors per rank\n"
-      "   (of 16 24 32 48 64 96 128) with METIS imbalance <= %.2f; ghosts, max, g/own: mean and "
-      "max ghosts\n"
-      "   per rank and all ghosts / N for metis16 ((64): metis64); eq ghost, g/own: the same for "
-      "equal16\n",
-      kTarget);
+  print_table(cases, rows);
+  print_halo_limits(cases, rows);
 
   const std::string csv = opt.results + "/partition.csv";
   std::filesystem::create_directories(opt.results);
   std::ofstream out(csv);
   out << "charge,n_particles,work,nranks,sectors_per_rank,n_sectors,method,method_detail,"
          "imbalance,owned_min,owned_max,ghosts_mean,ghosts_max,ghost_ratio,partition_ms,"
-         "halo_width\n";
+         "halo_width,rank_ghost_ratio_max,ranks_halo_over_half,wedge_min_deg,wedge_min_shell\n";
   char buf[512];
   for (const Row& r : rows) {
     std::snprintf(buf, sizeof buf,
-                  "%s,%lld,%s,%d,%d,%d,%s,\"%s\",%.6f,%lld,%lld,%.3f,%lld,%.6f,%.3f,%.4f\n",
+                  "%s,%lld,%s,%d,%d,%d,%s,\"%s\",%.6f,%lld,%lld,%.3f,%lld,%.6f,%.3f,%.4f,%.6f,%d,"
+                  "%.5f,%.5f\n",
                   r.charge.c_str(), static_cast<long long>(r.n_particles), r.work.c_str(), r.nranks,
                   r.spr, r.nranks * r.spr, r.method.c_str(), r.detail.c_str(), r.imbalance,
                   static_cast<long long>(r.owned_min), static_cast<long long>(r.owned_max),
-                  r.ghosts_mean, static_cast<long long>(r.ghosts_max), r.ghost_ratio, r.ms, kHalo);
+                  r.ghosts_mean, static_cast<long long>(r.ghosts_max), r.ghost_ratio, r.ms, kHalo,
+                  r.rank_ratio_max, r.ranks_over_limit, r.wedge_min_deg, r.wedge_min_shell);
     out << buf;
   }
   out.close();
