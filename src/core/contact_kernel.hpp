@@ -292,52 +292,74 @@ void Kernel<Model>::release_ended(const ParticleStore& p, const Walls& walls, co
 template <class Model>
 std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
                                         std::size_t k1) {
+  // Every column through a local pointer: the int32 stores below may alias any int member, so
+  // the compiler would otherwise reload n_mat_, the store's size and the columns' addresses on
+  // every iteration.
   const Vec2* x = p.pos.data();
   const double* r = p.radius.data();
+  const std::int32_t* li = pl.i.data();
+  const std::int32_t* lj = pl.j.data();
   double* trial = pl.trial.data();
-  const bool records = !pl.canonical();
-  std::uint8_t* touch = touch_.data();
+  std::int32_t* pair = b_.pair.data();
+  double* dx = b_.dx.data();
+  double* dy = b_.dy.data();
+  double* dist2_out = b_.dist2.data();
   std::size_t n = 0;
   for (std::size_t k = k0; k < k1; ++k) {
-    const std::int32_t i = pl.i[k], j = pl.j[k];
+    const std::int32_t i = li[k], j = lj[k];
     const Vec2 d = x[j] - x[i];
     const double dist2 = norm2(d);
     const double rsum = r[i] + r[j];
     for (std::size_t s = 0; s < W; ++s) trial[k * W + s] = 0.0;  // the scatter rewrites contacts
-    b_.pair[n] = static_cast<std::int32_t>(k);
-    b_.dx[n] = d.x;
-    b_.dy[n] = d.y;
-    b_.dist2[n] = dist2;
+    pair[n] = static_cast<std::int32_t>(k);
+    dx[n] = d.x;
+    dy[n] = d.y;
+    dist2_out[n] = dist2;
     // Written so that a NaN distance counts as a contact: its NaN forces are then caught by the
     // stability check instead of the particle silently dropping out of every contact.
     n += !(dist2 >= rsum * rsum) ? 1 : 0;
   }
-  if (records) {  // apart from the loop above: a byte store there aliases everything
+  if (!pl.canonical()) {  // apart from the loop above: a byte store there aliases everything
+    std::uint8_t* touch = touch_.data();
     std::fill(touch + k0, touch + k1, std::uint8_t{0});
-    for (std::size_t c = 0; c < n; ++c) touch[b_.pair[c]] = 1;
+    for (std::size_t c = 0; c < n; ++c) touch[pair[c]] = 1;
   }
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
   const double* m = p.mass.data();
   const std::int32_t* mat = p.material.data();
   const double* hist = pl.history.data();
+  const std::size_t n_owned = p.n_owned();
+  const std::int32_t n_mat = n_mat_;
+  std::int32_t* coeff = b_.coeff.data();
+  double* counted = b_.counted.data();
+  double* r_i = b_.r_i.data();
+  double* r_j = b_.r_j.data();
+  double* m_i = b_.m_i.data();
+  double* m_j = b_.m_j.data();
+  double* vx = b_.vx.data();
+  double* vy = b_.vy.data();
+  double* spin = b_.spin.data();
+  double* omega_rel = b_.omega_rel.data();
+  std::array<double*, W> old{};
+  for (std::size_t s = 0; s < W; ++s) old[s] = b_.history.old[s].data();
   for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t k = b_.pair[c];
-    const std::int32_t i = pl.i[k], j = pl.j[k];
-    b_.coeff[c] = mat[i] * n_mat_ + mat[j];
+    const std::int32_t k = pair[c];
+    const std::int32_t i = li[k], j = lj[k];
+    // One material: the kernel uses its one coefficient set (coeffs_of) and reads no index.
+    if (n_mat != 1) coeff[c] = mat[i] * n_mat + mat[j];
     // A pair across a rank boundary is computed on both ranks; its energies and its count go
     // to the rank that owns the lower-id particle (i) only.
-    b_.counted[c] = static_cast<std::size_t>(i) < p.n_owned() ? 1.0 : 0.0;
-    b_.r_i[c] = r[i];
-    b_.r_j[c] = r[j];
-    b_.m_i[c] = m[i];
-    b_.m_j[c] = m[j];
-    b_.vx[c] = v[i].x - v[j].x;
-    b_.vy[c] = v[i].y - v[j].y;
-    b_.spin[c] = w[i] * r[i] + w[j] * r[j];
-    b_.omega_rel[c] = w[i] - w[j];
-    for (std::size_t s = 0; s < W; ++s)
-      b_.history.old[s][c] = hist[static_cast<std::size_t>(k) * W + s];
+    counted[c] = static_cast<std::size_t>(i) < n_owned ? 1.0 : 0.0;
+    r_i[c] = r[i];
+    r_j[c] = r[j];
+    m_i[c] = m[i];
+    m_j[c] = m[j];
+    vx[c] = v[i].x - v[j].x;
+    vy[c] = v[i].y - v[j].y;
+    spin[c] = w[i] * r[i] + w[j] * r[j];
+    omega_rel[c] = w[i] - w[j];
+    for (std::size_t s = 0; s < W; ++s) old[s][c] = hist[static_cast<std::size_t>(k) * W + s];
   }
   for (std::size_t c = n; c < padded(n); ++c) b_.copy(c, n - 1);
   return n;

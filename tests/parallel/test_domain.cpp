@@ -370,9 +370,11 @@ double steps_fraction() {
 // Runs the scene serially and in parallel side by side for `steps` (times steps_fraction()
 // unless `full_length`), comparing every `every` (the same number of comparisons whatever the
 // fraction). `check` then looks at the serial run's end state.
+// `sorted`: the parallel run puts its particles in spatial order at every rebuild (the list in
+// storage order, forces summed through the records), the serial one keeps them in id order.
 void expect_same_as_serial(const Scene& scene, int steps, int every,
                            const std::function<void(const Simulation&)>& check = {},
-                           bool full_length = false) {
+                           bool full_length = false, bool sorted = false) {
   const double fraction = full_length ? 1.0 : steps_fraction();
   steps = std::max(1, static_cast<int>(std::lround(fraction * steps)));
   every = std::max(1, static_cast<int>(std::lround(fraction * every)));
@@ -382,8 +384,13 @@ void expect_same_as_serial(const Scene& scene, int steps, int every,
   opt.repartition_threshold = 1.05;  // repartition often: ownership changes must not matter
   opt.repartition_gap = 2;
   MpiDomain domain(MPI_COMM_WORLD, opt);
-  Simulation par(scene, &domain);
-  Simulation ser(scene);
+  Scene par_scene = scene, ser_scene = scene;
+  if (sorted) {
+    par_scene.run.spatial_sort = SpatialSort::kAlways;
+    ser_scene.run.spatial_sort = SpatialSort::kNever;
+  }
+  Simulation par(par_scene, &domain);
+  Simulation ser(ser_scene);
   ASSERT_EQ(par.dt(), ser.dt());
   std::int64_t bad = 0, checked = 0;
   std::string first;
@@ -425,9 +432,9 @@ Scene thesis_drum(int balls, double speed, int sides) {
   return testing_support::thesis_drum_scene(balls, speed, sides, /*ramp_time=*/0.1);
 }
 
-TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
-  // No gravity, an 8-sided shell at 6 rad/s stirring a dense polydisperse charge that fills
-  // the whole drum, centre included (where every wedge meets).
+// No gravity, an 8-sided shell at 6 rad/s stirring a dense polydisperse charge that fills the
+// whole drum, centre included (where every wedge meets).
+Scene polydisperse_centre_scene() {
   Scene s;
   s.title = "polydisperse, whole drum, centre filled";
   s.deck_path = "test_domain";
@@ -448,7 +455,19 @@ TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
   f.region = FillRegion::kFull;
   f.velocity = {0.3, -0.2};
   s.fills.push_back(f);
-  expect_same_as_serial(s, 6000, 500);
+  return s;
+}
+
+TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
+  expect_same_as_serial(polydisperse_centre_scene(), 6000, 500);
+}
+
+// Every rank sorts its particles along the Hilbert curve at every rebuild, ghosts and
+// migrations included; the serial run keeps id order: the same bits.
+TEST(Reproducibility, SpatiallySortedRanksMatchTheUnsortedSerialRun) {
+  Scene s = polydisperse_centre_scene();
+  s.title = "polydisperse, whole drum, ranks sorted in space";
+  expect_same_as_serial(s, 3000, 500, {}, false, /*sorted=*/true);
 }
 
 // Contacts across every wedge boundary from the first step: about 600 spheres of two radii
