@@ -9,7 +9,9 @@
 # commit in a second work tree (git worktree add ../old <commit>), then run this script with
 # both binaries. RANKS (default 1) is the rank count of both runs; the new binary at another
 # rank count must agree too (the decomposition is bit-identical at any rank count). Prints one
-# line per deck and exits 1 when any deck differs.
+# line per deck and exits 1 when any deck differs. NEW_ARGS (environment) is added to the new
+# binary's command line, e.g. NEW_ARGS="--set run.spatial_sort=always" to compare a store
+# sorted at every rebuild with the old binary's id order.
 set -u
 old=$1
 new=$2
@@ -19,11 +21,14 @@ src=$(cd "$(dirname "$0")/.." && pwd)
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 run() {
   local bin=$1 deck=$2 dir=$3
+  local -a extra=()
+  [ "$bin" = "$new" ] && read -r -a extra <<< "${NEW_ARGS:-}"
   rm -rf "$dir"  # one folder, one run: a rerun into the same OUT_DIR starts afresh
   if [ "$np" -gt 1 ]; then
-    mpirun -np "$np" --oversubscribe "$bin" --quiet --output "$dir" "$deck" > "$dir.log" 2>&1
+    mpirun -np "$np" --oversubscribe "$bin" --quiet --output "$dir" "${extra[@]}" "$deck" \
+      > "$dir.log" 2>&1
   else
-    "$bin" --quiet --output "$dir" "$deck" > "$dir.log" 2>&1
+    "$bin" --quiet --output "$dir" "${extra[@]}" "$deck" > "$dir.log" 2>&1
   fi
 }
 mkdir -p "$out"
