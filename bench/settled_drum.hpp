@@ -40,8 +40,14 @@
 // particles apart at metres per second), so the seams leave small gaps. The N lowest kept
 // particles (by y) are the charge, at rest; ids are given in the fill's order (fill_order: rows
 // of the fill's lattice pitch 2.1 r_max sqrt(3)/2 from the bottom up, a fixed pseudo-random
-// order within a row). Then stage 3 (steel, drum still, at least 3000, at most 10 000 steps)
-// loads the contacts of the deeper bed.
+// order within a row). Then stage 3 (steel, drum still, at least 3000, at most 10 000 steps).
+// Measured (1e6, 2026-11-26): stage 3 stopped after its 3000 steps with 0.50 contacts per
+// particle (the 30 000 source: 1.54; candidate pairs within 2.4 mm: 2.38 per particle in both).
+// The copied overlaps are those of the source's depth (1.4 m at most), not of the 10 m deep
+// bed, so they spring apart and the bed rattles at ~3 cm/s with micrometre gaps; loading it
+// under its own weight would take tens of ms (a compression wave over 10 m of spheres,
+// several passes: 3e4-5e4 steps of 1e6 particles, about an hour of CPU), which was not done.
+// So the tiled sizes have the candidate pairs of a settled bed but a third of its contacts.
 //
 // The size-ratio charges (settle_ratio_packing, bench/throughput's "ratios" section): N spheres
 // of the same steel with radii log-uniform between r_max / ratio and r_max = 10 mm (the

@@ -90,7 +90,9 @@ def draw(axes, rows, style, label_suffix, grey=False):
                  label=f"ns per particle-step (N = {ratio[0]['n_particles']})" + label_suffix)
         if not grey:
             for r in ratio:
-                axr.annotate(f"{num(r, 'cost_vs_mono'):.2f}x\n{num(r, 'contacts_per_particle'):.2f} c, "
+                cost = num(r, "cost_vs_mono", 0.0)
+                axr.annotate((f"{cost:.2f}x\n" if cost > 0 else "") +
+                             f"{num(r, 'contacts_per_particle'):.2f} c, "
                              f"{num(r, 'candidates_per_particle'):.2f} p",
                              (num(r, "size_ratio"), num(r, "ns_per_particle_step_cpu")),
                              textcoords="offset points", xytext=(5, -18), fontsize=7)
