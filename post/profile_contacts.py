@@ -70,10 +70,15 @@ def read_counts(path):
     return [float(v) for v in m.groups()]
 
 
-def short(name, width=60):
-    name = re.sub(r"\(.*\)", "()", name)  # drop parameter lists
+def short(name, width=70):
+    """The function's name without template arguments and parameters: Kernel<>::gather()."""
     name = re.sub(r"std::experimental::parallelism_v2::", "stdx::", name)
-    return name if len(name) <= width else name[: width - 3] + "..."
+    prev = None
+    while prev != name:
+        prev = name
+        name = re.sub(r"<[^<>]*>", "<>", name)
+        name = re.sub(r"\([^()]*\)", "()", name)
+    return name if len(name) <= width else "..." + name[-(width - 3):]
 
 
 def main():
