@@ -1,14 +1,16 @@
-// settled_drum.hpp: a settled charge of polydisperse steel spheres in a circular drum, shared by
-// bench/throughput.cpp and bench/bm_kernels.cpp (header only: bench/CMakeLists.txt builds each
-// bench/*.cpp as its own program).
+// settled_drum.hpp: settled charges of polydisperse steel spheres in a circular drum, shared by
+// bench/throughput.cpp, bench/strong_scaling.cpp and bench/bm_kernels.cpp (header only:
+// bench/CMakeLists.txt builds each bench/*.cpp as its own program).
 //
-// The charge: N steel spheres (thesis steel: rho 7800, E 2e11 Pa, G 8e10 Pa, e = 0.73,
+// The drum charge: N steel spheres (thesis steel: rho 7800, E 2e11 Pa, G 8e10 Pa, e = 0.73,
 // mu_s = 0.1, mu_r = 0.05), radius uniform in [6, 10] mm, in a circular drum (sides = 0) of
 // radius R(N) = 2.5 m sqrt(N / 30 000) (fill fraction 0.31 at every N) turning at
 // 1.5 rad/s sqrt(2.5 m / R) (Froude number 0.57 at every N). N = 30 000 is the 2.5 m drum at
 // 1.5 rad/s. Contact law hertz-mindlin with epsd rolling resistance.
 //
-// Settling (cheap, not what is measured), in three stages, all with the drum still:
+// How each size is made.
+// N < 300 000 (1e3, 3e3, 1e4, 3e4, 1e5): settled by dynamics (settle_packing), in three stages,
+// all with the drum still:
 //  1. The core's fill (region "bottom": a loose hexagonal lattice, seed 1) falls and settles in
 //     a soft copy of the steel (e = 0.1, mu_s = 0.3, E and G scaled by 1e-3 sqrt(N / 1000),
 //     i.e. in proportion to the bed depth, so that the overlaps (static and at the impacts of
@@ -26,21 +28,62 @@
 //  3. Steel, at dt = 1e-6 s: gravity closes the gaps and loads the contacts (~5-10 ms). It runs
 //     in chunks of 1000 steps until the number of contacts grows by less than 1 % in a chunk
 //     (at least 3000, at most 20 000 steps).
-// Positions, velocities (a few cm/s) and spins are cached in DIR/settled_drum_<N>.csv
-// (x, y, radius, vx, vy, spin), as settling 1e5 particles takes several minutes: delete the
-// file to settle again. The measured runs (settled_scene) start from it with the drum turning
-// at full speed; the benches run 500 untimed steps first.
+// N >= 300 000 (3e5, 1e6): settling by dynamics would take hours, so the packing is built
+// without dynamics by tiling the settled 30 000 packing (tile_packing: the construction of
+// tile_charge in bench/partition.cpp, with a stricter seam rule). A rectangular patch is cut
+// from the interior of the 30 000 charge (|x| < 0.64 R, from 0.02 R above the shell at
+// x = 0.64 R up to 0.05 R below the bed surface, the 99th percentile of y: about half the
+// charge); copies of it, side by side with the patch's width and height as periods, cover the
+// big drum (radius R(N) as above); a copy's particle is kept if it lies inside the drum and
+// overlaps no particle kept before it by more than the largest overlap in the settled 30 000
+// packing itself (micrometres; partition.cpp allows 0.1 mm, which in steel would fire the
+// particles apart at metres per second), so the seams leave small gaps. The N lowest kept
+// particles (by y) are the charge, at rest; ids are given in the fill's order (fill_order: rows
+// of the fill's lattice pitch 2.1 r_max sqrt(3)/2 from the bottom up, a fixed pseudo-random
+// order within a row). Then stage 3 (steel, drum still, at least 3000, at most 10 000 steps).
+// Measured (1e6, 2026-11-26): stage 3 stopped after its 3000 steps with 0.50 contacts per
+// particle (the 30 000 source: 1.54; candidate pairs within 2.4 mm: 2.38 per particle in both).
+// The copied overlaps are those of the source's depth (1.4 m at most), not of the 10 m deep
+// bed, so they spring apart and the bed rattles at ~3 cm/s with micrometre gaps; loading it
+// under its own weight would take tens of ms (a compression wave over 10 m of spheres,
+// several passes: 3e4-5e4 steps of 1e6 particles, about an hour of CPU), which was not done.
+// So the tiled sizes have the candidate pairs of a settled bed but a third of its contacts.
+//
+// The size-ratio charges (settle_ratio_packing, bench/throughput's "ratios" section): N spheres
+// of the same steel with radii log-uniform between r_max / ratio and r_max = 10 mm (the
+// deterministic quantiles r_k = r_max ratio^(-(k + 1/2) / N), k = 0 .. N-1: equal numbers per
+// factor of radius; ratio 1: every radius exactly 10 mm, the monodisperse reference), in a
+// circular drum of radius sqrt(sum r^2 / 0.31) (fill fraction 0.31 as above) turning at
+// 1.5 rad/s sqrt(2.5 m / R). The fill's lattice (spacing 2.1 r_max) cannot hold a 10:1 charge
+// at this fill fraction, so stage 1 starts instead from a random sequential placement (largest
+// first, no overlaps, fixed pseudo-random sequence) in the bottom segment of the drum whose
+// area is the charge's area / 0.4, ids in the fill's order as above. Then stages 1-3, with the
+// soft stiffness scaled by the bed depth and by the size ratio (E x 1e-3 ratio R / R(1000): a
+// small sphere wedged between large ones overlaps more, relative to its radius, than in a
+// monodisperse bed; at 1e-3 R / R(1000) alone the 5:1 and 10:1 beds passed the core's 25 %
+// overlap guard, as ratio^(4/3) predicts) and stage 3 at dt = 5e-7 s (steel
+// spheres of 1 mm: the core's limit dt is about 5.3e-7 s); the measured runs use 5e-7 s too.
+//
+// Positions, velocities (a few cm/s) and spins are cached in DIR/settled_drum_<N>.csv and
+// DIR/settled_ratio<ratio>_<N>.csv (x, y, radius, vx, vy, spin; the first line says how the
+// packing was made), as settling 1e5 particles takes several minutes: delete a file to make it
+// again. The measured runs (settled_scene) start from it with the drum turning at full speed;
+// the benches run untimed steps first.
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/scene.hpp"
@@ -51,6 +94,11 @@ namespace bench {
 constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m
 constexpr double kRefN = 30000.0, kRefDrum = 2.5, kRefSpeed = 1.5;
 constexpr const char* kCacheVersion = "settled_drum v7";  // bump when the recipe changes
+constexpr const char* kRatioCacheVersion = "settled_drum ratio v1";
+constexpr std::int64_t kTileFrom = 300000;  // N >= this: tiled from the kTileBase packing
+constexpr std::int64_t kTileBase = 30000;
+constexpr double kFillFraction = 0.31;  // charge area / drum area
+constexpr double kRatioDt = 5.0e-7;     // s: every size-ratio run (1 mm steel spheres)
 
 inline double drum_radius_for(std::int64_t n) {
   return kRefDrum * std::sqrt(static_cast<double>(n) / kRefN);
@@ -111,7 +159,14 @@ struct Packing {
   int relax_rounds = 0;                // candidate-pair rebuilds of stage 2
   std::int64_t load_steps = 0;         // steps of stage 3
   double contacts_per_particle = 0.0;  // at the end of stage 3
+  double drum_radius = 0.0;            // m; 0: drum_radius_for(N)
+  std::string recipe;                  // how it was made (the cache file's first line)
 };
+
+inline double drum_radius_of(const Packing& pk) {
+  return pk.drum_radius > 0.0 ? pk.drum_radius
+                              : drum_radius_for(static_cast<std::int64_t>(pk.pos.size()));
+}
 
 // Stage 2: remove the overlaps of the candidate pairs (local indices pi, pj) and with the drum
 // wall (centred at the origin), by Gauss-Seidel sweeps with over-relaxation. Sweeps run until
@@ -160,7 +215,7 @@ inline bool relax_overlaps(std::vector<dem2d::Vec2>& x, const std::vector<double
 // A scene of the packing's particles (with their velocities) in `material`, dt given.
 inline dem2d::Scene packing_scene(const Packing& pk, const dem2d::MaterialSpec& material,
                                   double drum_speed, double dt) {
-  const double radius = drum_radius_for(static_cast<std::int64_t>(pk.pos.size()));
+  const double radius = drum_radius_of(pk);
   dem2d::Scene s = drum_scene(radius, drum_speed);
   s.materials = {material};
   s.particles.resize(pk.pos.size());
@@ -178,7 +233,7 @@ inline dem2d::Scene packing_scene(const Packing& pk, const dem2d::MaterialSpec& 
 
 // The measured scene: steel, the drum turning at its full speed from t = 0.
 inline dem2d::Scene settled_scene(const Packing& pk, double dt) {
-  const double radius = drum_radius_for(static_cast<std::int64_t>(pk.pos.size()));
+  const double radius = drum_radius_of(pk);
   return packing_scene(pk, steel(1.0), drum_speed_for(radius), dt);
 }
 
@@ -205,39 +260,14 @@ inline double half_limit_dt(dem2d::Scene s) {
   return 0.5 * probe.scales().limit_dt;
 }
 
-inline Packing settle_packing(std::int64_t n) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const double radius = drum_radius_for(n);
-  Packing out;
-  // Stage 1: the soft fill falls and settles.
-  dem2d::Scene s = drum_scene(radius, 0.0);
-  s.materials = {settling_material(soft_factor_for(n))};
-  dem2d::FillSpec fill;
-  fill.material = "steel";
-  fill.count = n;
-  fill.radius_min = kRadiusMin;
-  fill.radius_max = kRadiusMax;
-  fill.region = dem2d::FillRegion::kBottom;
-  s.fills = {fill};
-  s.run.dt = half_limit_dt(s);
-  s.run.dt_auto = false;
-  s.run.allow_unsafe_dt = true;
-  dem2d::Simulation sim(s);
-  double mass = 0.0;
-  for (std::size_t k = 0; k < sim.particles().n_owned(); ++k) mass += sim.particles().mass[k];
-  while (true) {
-    sim.run_until(sim.time() + 0.05);
-    const double v = std::sqrt(2.0 * sim.diagnostics().kinetic_energy / mass);
-    if ((sim.time() >= 0.4 && v < 0.02) || sim.time() >= 1.0) break;
-  }
-  out.settle_time = sim.time();
-  take_state(sim, out);  // (the store is in id order: the core has not reordered it)
-  // Stage 2: relaxation rounds, each with the candidate pairs of the positions it starts from.
+// Stage 2: the overlaps of `out` (the state of `sim`'s particles, indexed by id) removed
+// geometrically; `sim` gives the candidate pairs (any material: only its lists are used).
+inline void remove_overlaps(dem2d::Simulation& sim, Packing& out, double radius) {
   dem2d::ParticleStore& store = sim.particles();
   bool relaxed = false;
   double worst = 0.0;
   for (int round = 0; round < 2000 && !relaxed; ++round) {
-    for (std::size_t k = 0; k < out.pos.size(); ++k)
+    for (std::size_t k = 0; k < store.n_owned(); ++k)
       store.pos[k] = out.pos[static_cast<std::size_t>(store.id[k])];
     sim.rebuild();
     std::vector<std::int32_t> pi(sim.pairs().i.begin(), sim.pairs().i.end()),
@@ -253,7 +283,7 @@ inline Packing settle_packing(std::int64_t n) {
                              std::to_string(out.relax_rounds) + " rounds)");
   // Whatever is left is removed by shrinking radii: each particle by half of its largest pair
   // overlap plus its wall overlap.
-  for (std::size_t k = 0; k < out.pos.size(); ++k)
+  for (std::size_t k = 0; k < store.n_owned(); ++k)
     store.pos[k] = out.pos[static_cast<std::size_t>(store.id[k])];
   sim.rebuild();
   std::vector<double> shrink(out.pos.size(), 0.0);
@@ -275,72 +305,432 @@ inline Packing settle_packing(std::int64_t n) {
                              " m is left after the relaxation");
   std::fill(out.vel.begin(), out.vel.end(), dem2d::Vec2{});
   std::fill(out.spin.begin(), out.spin.end(), 0.0);
-  // Stage 3: steel until the contacts stop growing.
-  {
-    dem2d::Simulation steel_sim(packing_scene(out, steel(1.0), 0.0, 1.0e-6));
-    double contacts = 0.0;
-    for (int chunk = 0; chunk < 20; ++chunk) {
-      for (int k = 0; k < 1000; ++k) steel_sim.step();
-      const double c = static_cast<double>(steel_sim.last_totals().contacts);
-      const bool flat = c < 1.01 * contacts;
-      contacts = c;
-      if (chunk >= 2 && flat) break;
-    }
-    out.load_steps = steel_sim.step_count();
-    out.contacts_per_particle = contacts / static_cast<double>(n);
-    take_state(steel_sim, out);
+}
+
+// Stage 3: steel at `dt` with the drum still, in chunks of 1000 steps until the contacts grow by
+// less than 1 % in a chunk (at least 3 chunks, at most `max_chunks`).
+inline void load_in_steel(Packing& out, double dt, int max_chunks = 20) {
+  dem2d::Simulation steel_sim(packing_scene(out, steel(1.0), 0.0, dt));
+  double contacts = 0.0;
+  for (int chunk = 0; chunk < max_chunks; ++chunk) {
+    for (int k = 0; k < 1000; ++k) steel_sim.step();
+    const double c = static_cast<double>(steel_sim.last_totals().contacts);
+    const bool flat = c < 1.01 * contacts;
+    contacts = c;
+    if (chunk >= 2 && flat) break;
   }
+  out.load_steps = steel_sim.step_count();
+  out.contacts_per_particle = contacts / static_cast<double>(out.pos.size());
+  take_state(steel_sim, out);
+}
+
+// Stages 1-3 from the scene of stage 1 (soft material, drum still, particles in place).
+inline Packing settle_scene(dem2d::Scene s, double radius, double load_dt) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Packing out;
+  out.drum_radius = radius;
+  s.run.dt = half_limit_dt(s);
+  s.run.dt_auto = false;
+  s.run.allow_unsafe_dt = true;
+  dem2d::Simulation sim(s);
+  double mass = 0.0;
+  for (std::size_t k = 0; k < sim.particles().n_owned(); ++k) mass += sim.particles().mass[k];
+  while (true) {
+    sim.run_until(sim.time() + 0.05);
+    const double v = std::sqrt(2.0 * sim.diagnostics().kinetic_energy / mass);
+    if ((sim.time() >= 0.4 && v < 0.02) || sim.time() >= 1.0) break;
+  }
+  out.settle_time = sim.time();
+  take_state(sim, out);
+  remove_overlaps(sim, out, radius);
+  load_in_steel(out, load_dt);
   out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }
 
-// The settled packing of N particles, read from DIR/settled_drum_<N>.csv or settled and written
-// there.
-inline Packing settled_packing(std::int64_t n, const std::string& cache_dir, bool verbose = true) {
-  const std::string path = cache_dir + "/settled_drum_" + std::to_string(n) + ".csv";
-  if (std::ifstream in(path); in) {
-    std::string header;
-    std::getline(in, header);
-    if (header.find(kCacheVersion) != std::string::npos) {
-      Packing out;
-      out.from_cache = true;
-      std::string line;
-      std::getline(in, line);  // column names
-      while (std::getline(in, line)) {
-        double x, y, r, vx, vy, w;
-        char c[5];
-        std::istringstream ls(line);
-        if (ls >> x >> c[0] >> y >> c[1] >> r >> c[2] >> vx >> c[3] >> vy >> c[4] >> w) {
-          out.pos.push_back({x, y});
-          out.radius.push_back(r);
-          out.vel.push_back({vx, vy});
-          out.spin.push_back(w);
-        }
+inline Packing settle_packing(std::int64_t n) {
+  const double radius = drum_radius_for(n);
+  // Stage 1: the soft fill falls and settles.
+  dem2d::Scene s = drum_scene(radius, 0.0);
+  s.materials = {settling_material(soft_factor_for(n))};
+  dem2d::FillSpec fill;
+  fill.material = "steel";
+  fill.count = n;
+  fill.radius_min = kRadiusMin;
+  fill.radius_max = kRadiusMax;
+  fill.region = dem2d::FillRegion::kBottom;
+  s.fills = {fill};
+  Packing out = settle_scene(s, radius, 1.0e-6);
+  out.drum_radius = 0.0;  // drum_radius_for(n)
+  return out;
+}
+
+// Uniform cell grid over a set of points (counting sort): neighbours() visits the 3 x 3 cells
+// around a point.
+class PointGrid {
+ public:
+  PointGrid(const std::vector<dem2d::Vec2>& x, double cell) : cell_(cell) {
+    lo_ = {1e300, 1e300};
+    dem2d::Vec2 hi{-1e300, -1e300};
+    for (dem2d::Vec2 p : x) {
+      lo_ = {std::min(lo_.x, p.x), std::min(lo_.y, p.y)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
+    }
+    nx_ = static_cast<int>((hi.x - lo_.x) / cell_) + 1;
+    ny_ = static_cast<int>((hi.y - lo_.y) / cell_) + 1;
+    start_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_) + 1, 0);
+    for (dem2d::Vec2 p : x) ++start_[index(p) + 1];
+    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
+    items_.resize(x.size());
+    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < x.size(); ++i) items_[fill[index(x[i])]++] = i;
+  }
+  template <class F>
+  void neighbours(dem2d::Vec2 p, F&& f) const {
+    const int cx = cx_of(p), cy = cy_of(p);
+    for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y)
+      for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x) {
+        const std::size_t c = static_cast<std::size_t>(y) * static_cast<std::size_t>(nx_) +
+                              static_cast<std::size_t>(x);
+        for (std::size_t k = start_[c]; k < start_[c + 1]; ++k) f(items_[k]);
       }
-      if (static_cast<std::int64_t>(out.pos.size()) == n) return out;
+  }
+
+ private:
+  int cx_of(dem2d::Vec2 p) const {
+    return std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
+  }
+  int cy_of(dem2d::Vec2 p) const {
+    return std::clamp(static_cast<int>((p.y - lo_.y) / cell_), 0, ny_ - 1);
+  }
+  std::size_t index(dem2d::Vec2 p) const {
+    return static_cast<std::size_t>(cy_of(p)) * static_cast<std::size_t>(nx_) +
+           static_cast<std::size_t>(cx_of(p));
+  }
+  double cell_;
+  dem2d::Vec2 lo_;
+  int nx_ = 1, ny_ = 1;
+  std::vector<std::size_t> start_, items_;
+};
+
+inline std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ULL;
+  x = (x ^ (x >> 30U)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27U)) * 0x94D049BB133111EBULL;
+  return x ^ (x >> 31U);
+}
+
+// The particles (pos, radius) reordered as the core's fill numbers them: rows of the fill's
+// lattice pitch (2.1 r_max sqrt(3) / 2) from the bottom up, a fixed pseudo-random order within
+// a row (the fill draws which sites of the last row it takes; the jitter mixes each row).
+inline void fill_order(std::vector<dem2d::Vec2>& pos, std::vector<double>& radius) {
+  const double pitch = 2.1 * kRadiusMax * std::sqrt(3.0) / 2.0;
+  double y0 = 1e300;
+  for (dem2d::Vec2 p : pos) y0 = std::min(y0, p.y);
+  std::vector<std::pair<std::pair<std::int64_t, std::uint64_t>, std::size_t>> key(pos.size());
+  for (std::size_t k = 0; k < pos.size(); ++k)
+    key[k] = {{static_cast<std::int64_t>((pos[k].y - y0) / pitch), splitmix64(k)}, k};
+  std::sort(key.begin(), key.end());
+  std::vector<dem2d::Vec2> p2(pos.size());
+  std::vector<double> r2(pos.size());
+  for (std::size_t k = 0; k < key.size(); ++k) {
+    p2[k] = pos[key[k].second];
+    r2[k] = radius[key[k].second];
+  }
+  pos.swap(p2);
+  radius.swap(r2);
+}
+
+inline double percentile_y(const std::vector<dem2d::Vec2>& x, double q) {
+  std::vector<double> y;
+  y.reserve(x.size());
+  for (dem2d::Vec2 p : x) y.push_back(p.y);
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(y.size() - 1));
+  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
+  return y[k];
+}
+
+// The largest overlap between any two particles of a packing.
+inline double largest_overlap(const std::vector<dem2d::Vec2>& x, const std::vector<double>& r) {
+  const PointGrid grid(x, 2.0 * kRadiusMax);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    grid.neighbours(x[i], [&](std::size_t j) {
+      if (j > i) worst = std::max(worst, r[i] + r[j] - dem2d::norm(x[i] - x[j]));
+    });
+  return worst;
+}
+
+// The tiled charge of n_target particles (header: N >= 300 000) from the settled packing `a`
+// (drum radius drum_radius_of(a)); velocities and spins zero, not yet loaded in steel.
+inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
+  const double R = drum_radius_of(a);
+  const double Rb = drum_radius_for(n_target);
+  const double scale = Rb / R;
+  const double surface = percentile_y(a.pos, 0.99);
+  const double half = 0.64 * R;
+  const double y0 = -std::sqrt(R * R - half * half) + 0.02 * R, y1 = surface - 0.05 * R;
+  const double w = 2.0 * half, h = y1 - y0;
+  std::vector<std::size_t> patch;
+  for (std::size_t i = 0; i < a.pos.size(); ++i)
+    if (std::abs(a.pos[i].x) < half && a.pos[i].y >= y0 && a.pos[i].y < y1) patch.push_back(i);
+  const double top = surface * scale + 0.1 * Rb;  // generous: trimmed to n_target below
+  const int cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
+  const int rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
+  std::vector<dem2d::Vec2> cand;
+  std::vector<double> cand_r;
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < cols; ++i)
+      for (std::size_t k : patch) {
+        const dem2d::Vec2 p{a.pos[k].x + half - Rb + i * w, a.pos[k].y - y0 - Rb + j * h};
+        if (p.y > top || dem2d::norm(p) + a.radius[k] > Rb) continue;
+        cand.push_back(p);
+        cand_r.push_back(a.radius[k]);
+      }
+  // Keep-first at the seams: no overlap above the source packing's own largest.
+  const double allowed = std::max(largest_overlap(a.pos, a.radius), 1e-9);
+  const PointGrid grid(cand, 2.0 * kRadiusMax);
+  std::vector<char> kept(cand.size(), 0);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < cand.size(); ++i) {
+    bool clash = false;
+    grid.neighbours(cand[i], [&](std::size_t u) {
+      if (!clash && kept[u] && dem2d::norm(cand[i] - cand[u]) < cand_r[i] + cand_r[u] - allowed)
+        clash = true;
+    });
+    if (!clash) {
+      kept[i] = 1;
+      order.push_back(i);
     }
   }
+  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
+    return cand[p].y != cand[q].y ? cand[p].y < cand[q].y : cand[p].x < cand[q].x;
+  });
+  if (static_cast<std::int64_t>(order.size()) < n_target)
+    throw std::runtime_error("settled_drum: tiling gave only " + std::to_string(order.size()) +
+                             " particles");
+  order.resize(static_cast<std::size_t>(n_target));
+  Packing b;
+  for (std::size_t i : order) {
+    b.pos.push_back(cand[i]);
+    b.radius.push_back(cand_r[i]);
+  }
+  fill_order(b.pos, b.radius);
+  b.vel.assign(b.pos.size(), dem2d::Vec2{});
+  b.spin.assign(b.pos.size(), 0.0);
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "tiled from the settled %zu packing: patch |x| < %.4g m, y in [%.4g, %.4g) m (%zu "
+                "particles), %d x %d copies, %zu candidates, %zu kept (seam overlaps <= %.3g m), "
+                "the %lld lowest",
+                a.pos.size(), half, y0, y1, patch.size(), cols, rows, cand.size(),
+                static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), allowed,
+                static_cast<long long>(n_target));
+  b.recipe = buf;
+  return b;
+}
+
+// Size-ratio charges (header): the radii, r_max ratio^(-(k + 1/2) / n) for k = 0 .. n-1.
+inline std::vector<double> ratio_radii(std::int64_t n, double ratio) {
+  std::vector<double> r(static_cast<std::size_t>(n));
+  for (std::size_t k = 0; k < r.size(); ++k)
+    r[k] = kRadiusMax * std::pow(ratio, -(static_cast<double>(k) + 0.5) / static_cast<double>(n));
+  return r;
+}
+inline double ratio_drum_radius(std::int64_t n, double ratio) {
+  double area = 0.0;
+  for (double r : ratio_radii(n, ratio)) area += r * r;
+  return std::sqrt(area / kFillFraction);
+}
+
+// Area of the drum (radius R, centre 0) below the line y = c.
+inline double area_below(double R, double c) {
+  return R * R * (std::numbers::pi - std::acos(c / R)) + c * std::sqrt(R * R - c * c);
+}
+
+// Random sequential placement, largest first, of radii `r` (descending) in the segment of the
+// drum below the line whose area is sum(pi r^2) / `fraction`; the line moves up by 1 % of R
+// whenever 20 000 tries do not place a particle.
+inline std::vector<dem2d::Vec2> loose_placement(const std::vector<double>& r, double R,
+                                                double fraction = 0.4) {
+  double area = 0.0;
+  for (double v : r) area += std::numbers::pi * v * v;
+  double lo = -R, hi = R;
+  for (int it = 0; it < 100; ++it)
+    (area_below(R, 0.5 * (lo + hi)) < area / fraction ? lo : hi) = 0.5 * (lo + hi);
+  double top = hi;
+  const double cell = 2.0 * kRadiusMax;
+  const int nx = static_cast<int>(2.0 * R / cell) + 1;
+  std::vector<std::vector<std::size_t>> cells(static_cast<std::size_t>(nx) *
+                                              static_cast<std::size_t>(nx));
+  auto cell_of = [&](double v) { return std::clamp(static_cast<int>((v + R) / cell), 0, nx - 1); };
+  std::vector<dem2d::Vec2> pos(r.size());
+  std::uint64_t draw = 0;
+  auto uniform = [&]() {
+    return static_cast<double>(splitmix64(draw++) >> 11U) * 0x1.0p-53;  // [0, 1)
+  };
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    for (int tries = 0;; ++tries) {
+      if (tries == 20000) {
+        top = std::min(R, top + 0.01 * R);
+        tries = 0;
+      }
+      const dem2d::Vec2 p{-R + 2.0 * R * uniform(), -R + (top + R) * uniform()};
+      if (dem2d::norm(p) + r[k] > R * (1.0 - 1e-6)) continue;
+      bool clash = false;
+      const int cx = cell_of(p.x), cy = cell_of(p.y);
+      for (int y = std::max(0, cy - 1); y <= std::min(nx - 1, cy + 1) && !clash; ++y)
+        for (int x = std::max(0, cx - 1); x <= std::min(nx - 1, cx + 1) && !clash; ++x)
+          for (std::size_t j : cells[static_cast<std::size_t>(y * nx + x)])
+            if (dem2d::norm(p - pos[j]) < r[k] + r[j]) {
+              clash = true;
+              break;
+            }
+      if (clash) continue;
+      pos[k] = p;
+      cells[static_cast<std::size_t>(cy * nx + cx)].push_back(k);
+      break;
+    }
+  }
+  return pos;
+}
+
+// A settled size-ratio charge (header), by dynamics.
+inline Packing settle_ratio_packing(std::int64_t n, double ratio) {
+  const double radius = ratio_drum_radius(n, ratio);
+  std::vector<double> r = ratio_radii(n, ratio);  // descending
+  std::vector<dem2d::Vec2> pos = loose_placement(r, radius);
+  fill_order(pos, r);
+  dem2d::Scene s = drum_scene(radius, 0.0);
+  s.title = "bench: polydisperse steel, size ratio " + std::to_string(ratio);
+  // Stiffness: the bed depth as for the drum, times the ratio (a 1 mm sphere wedged between
+  // 10 mm ones overlapped by 25.5 % of its radius at 1x, beyond the core's 25 % guard).
+  s.materials = {settling_material(1.0e-3 * radius / drum_radius_for(1000) * ratio)};
+  s.particles.resize(pos.size());
+  for (std::size_t k = 0; k < pos.size(); ++k) {
+    s.particles[k].material = "steel";
+    s.particles[k].radius = r[k];
+    s.particles[k].position = pos[k];
+  }
+  return settle_scene(s, radius, kRatioDt);
+}
+
+inline void write_packing(const std::string& path, const std::string& header, const Packing& pk) {
+  std::ofstream f(path);
+  f << "# " << header << "\n";
+  f << "x,y,radius,vx,vy,spin\n";
+  char buf[256];
+  for (std::size_t k = 0; k < pk.pos.size(); ++k) {
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", pk.pos[k].x,
+                  pk.pos[k].y, pk.radius[k], pk.vel[k].x, pk.vel[k].y, pk.spin[k]);
+    f << buf;
+  }
+}
+
+// The packing of `path` if it exists, its first line holds `version` and it has n particles.
+inline std::optional<Packing> read_packing(const std::string& path, const std::string& version,
+                                           std::int64_t n) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  std::string header;
+  std::getline(in, header);
+  if (header.find(version) == std::string::npos) return std::nullopt;
+  Packing out;
+  out.from_cache = true;
+  out.recipe = header.size() > 2 ? header.substr(2) : header;
+  std::string line;
+  std::getline(in, line);  // column names
+  while (std::getline(in, line)) {
+    double x, y, r, vx, vy, w;
+    char c[5];
+    std::istringstream ls(line);
+    if (ls >> x >> c[0] >> y >> c[1] >> r >> c[2] >> vx >> c[3] >> vy >> c[4] >> w) {
+      out.pos.push_back({x, y});
+      out.radius.push_back(r);
+      out.vel.push_back({vx, vy});
+      out.spin.push_back(w);
+    }
+  }
+  if (static_cast<std::int64_t>(out.pos.size()) != n) return std::nullopt;
+  return out;
+}
+
+inline std::string drum_cache_path(std::int64_t n, const std::string& cache_dir) {
+  return cache_dir + "/settled_drum_" + std::to_string(n) + ".csv";
+}
+
+// The drum packing of N particles if DIR/settled_drum_<N>.csv holds it (never settles).
+inline std::optional<Packing> cached_packing(std::int64_t n, const std::string& cache_dir) {
+  return read_packing(drum_cache_path(n, cache_dir), kCacheVersion, n);
+}
+
+inline std::string settle_note(const Packing& out) {
+  std::ostringstream f;
+  f << "overlaps removed in " << out.relax_rounds << " rounds (residual " << out.residual_overlap
+    << " m), loaded in steel for " << out.load_steps << " steps (" << out.contacts_per_particle
+    << " contacts per particle); " << out.settle_wall << " s of wall time";
+  return f.str();
+}
+
+// The settled drum packing of N particles (header: tiled for N >= 300 000), read from
+// DIR/settled_drum_<N>.csv or made and written there.
+inline Packing settled_packing(std::int64_t n, const std::string& cache_dir, bool verbose = true) {
+  const std::string path = drum_cache_path(n, cache_dir);
+  if (std::optional<Packing> pk = cached_packing(n, cache_dir)) return *pk;
   if (verbose) {
     std::printf("   settling %lld particles (cached afterwards in %s) ...\n",
                 static_cast<long long>(n), path.c_str());
     std::fflush(stdout);
   }
-  Packing out = settle_packing(n);
-  std::filesystem::create_directories(cache_dir);
-  std::ofstream f(path);
-  f << "# " << kCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n)
-    << " m; settled soft (E x " << soft_factor_for(n) << ") for " << out.settle_time
-    << " s, overlaps removed in " << out.relax_rounds << " rounds (residual "
-    << out.residual_overlap << " m), loaded in steel for " << out.load_steps << " steps ("
-    << out.contacts_per_particle << " contacts per particle); " << out.settle_wall
-    << " s of wall time\n";
-  f << "x,y,radius,vx,vy,spin\n";
-  char buf[256];
-  for (std::size_t k = 0; k < out.pos.size(); ++k) {
-    std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", out.pos[k].x,
-                  out.pos[k].y, out.radius[k], out.vel[k].x, out.vel[k].y, out.spin[k]);
-    f << buf;
+  Packing out;
+  std::ostringstream head;
+  head << kCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; ";
+  if (n >= kTileFrom) {
+    const Packing base = settled_packing(kTileBase, cache_dir, verbose);
+    const auto t0 = std::chrono::steady_clock::now();
+    out = tile_packing(base, n);
+    out.drum_radius = 0.0;
+    load_in_steel(out, 1.0e-6, 10);
+    out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    head << out.recipe << "; loaded in steel for " << out.load_steps << " steps ("
+         << out.contacts_per_particle << " contacts per particle); " << out.settle_wall
+         << " s of wall time";
+  } else {
+    out = settle_packing(n);
+    head << "settled soft (E x " << soft_factor_for(n) << ") for " << out.settle_time << " s, "
+         << settle_note(out);
   }
+  out.recipe = head.str();
+  std::filesystem::create_directories(cache_dir);
+  write_packing(path, out.recipe, out);
+  return out;
+}
+
+// The settled size-ratio packing (header), read from DIR/settled_ratio<ratio>_<N>.csv or settled
+// and written there.
+inline Packing ratio_packing(std::int64_t n, double ratio, const std::string& cache_dir,
+                             bool verbose = true) {
+  char name[64];
+  std::snprintf(name, sizeof name, "/settled_ratio%g_%lld.csv", ratio, static_cast<long long>(n));
+  const std::string path = cache_dir + name;
+  if (std::optional<Packing> pk = read_packing(path, kRatioCacheVersion, n)) {
+    pk->drum_radius = ratio_drum_radius(n, ratio);
+    return *pk;
+  }
+  if (verbose) {
+    std::printf("   settling %lld particles of size ratio %g (cached afterwards in %s) ...\n",
+                static_cast<long long>(n), ratio, path.c_str());
+    std::fflush(stdout);
+  }
+  Packing out = settle_ratio_packing(n, ratio);
+  std::ostringstream head;
+  head << kRatioCacheVersion << ": N = " << n << ", size ratio " << ratio
+       << ", radii log-uniform in [" << kRadiusMax / ratio << ", " << kRadiusMax
+       << "] m, drum radius " << out.drum_radius << " m; random sequential placement, settled "
+       << "soft for " << out.settle_time << " s, " << settle_note(out);
+  out.recipe = head.str();
+  std::filesystem::create_directories(cache_dir);
+  write_packing(path, out.recipe, out);
   return out;
 }
 
