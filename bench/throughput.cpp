@@ -27,6 +27,13 @@
 //            --repeats segments of --block-time s (2.5 s) timed; contacts and candidate pairs
 //            per particle are the means of samples every 10 ms of the timed segments. Target of
 //            issue 13: 40 million particle-steps/s.
+// order      Storage order (run.spatial_sort, core/spatial_order.hpp): the drum packings of
+//            --order-particles (default 1e5, 1e6) with their ids as the fill gave them (row by
+//            row: spatially coherent) and shuffled (a fixed random permutation: ids spatially
+//            random, as in a long-mixed charge or after grinding), each with the store kept in
+//            id order ("never") and as "auto" chooses (1e6 shuffled: sorted along the Hilbert
+//            curve, the list in storage order, forces summed through the records). Not in the
+//            default sections.
 // waterfall  The waterfall deck (inputs/waterfall_polygon.in, 10 s at dt = 1e-5 s) run through
 //            the Simulation API without output, against the target of 5 s (once, as before).
 //
@@ -49,10 +56,10 @@
 // section, N, size ratio, ...) and DIR/throughput.png (post/plot_throughput.py through
 // std::system; --no-plot skips it).
 //
-//   throughput [--sections drum,ratios,block,waterfall] [--quick] [--particles N1,N2,...]
+//   throughput [--sections drum,ratios,block,waterfall,order] [--quick] [--particles N1,...]
 //              [--ratios R1,R2,...] [--ratio-particles N] [--steps S] [--repeats R]
 //              [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot] [--no-cache]
-//              [--results DIR] [--csv NAME]
+//              [--results DIR] [--csv NAME] [--order-particles N1,N2,...]
 //   throughput --profile-block STEPS      (bench/profile_contacts.sh)
 //   throughput --profile-drum N STEPS
 //
@@ -76,6 +83,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -145,6 +153,7 @@ struct Options {
   std::vector<std::int64_t> particles = {1000, 3000, 10000, 30000, 100000, 1000000};
   std::vector<double> ratios = {1.0, 2.0, 5.0, 10.0};
   std::int64_t ratio_particles = 20000;
+  std::vector<std::int64_t> order_particles = {100000, 1000000};
   std::int64_t steps = 2000;
   int repeats = 2;
   double min_particle_steps = 3.0e7;
@@ -174,13 +183,24 @@ struct Row {
   std::int64_t neighbor_builds = 0;         // in all timed repeats
   double settle_wall = 0.0, settle_time = 0.0;
   double rss_per_particle = 0.0, store_per_particle = 0.0, pairs_per_particle = 0.0;
-  double cost_vs_mono = 0.0;  // ratio section: ns per particle-step / that of ratio 1
+  // ratio section: ns per particle-step / that of ratio 1; order: / that of the id-order store
+  double cost_vs_mono = 0.0;
+  // Storage order: the ids as filled ("fill") or shuffled, the run.spatial_sort mode, and the
+  // sorts the run made (in its warm-up and timed steps).
+  std::string ids = "fill";
+  dem2d::SpatialSort sort = dem2d::SpatialSort::kAuto;
+  std::int64_t sorts = 0;
   double rate_wall() const { return static_cast<double>(n) * steps / wall; }
   double rate_cpu() const { return static_cast<double>(n) * steps / cpu; }
   double ns_wall() const { return 1e9 / rate_wall(); }
   double ns_cpu() const { return 1e9 / rate_cpu(); }
   double spread() const { return cpu_max / cpu - 1.0; }
 };
+
+const char* sort_name(dem2d::SpatialSort s) {
+  return s == dem2d::SpatialSort::kNever ? "never" : s == dem2d::SpatialSort::kAlways ? "always"
+                                                                                       : "auto";
+}
 
 // Touching particle-particle pairs of the pair list (the bench's own count: the core counts
 // particle-particle and wall contacts together).
@@ -207,7 +227,12 @@ double pair_contacts(const Simulation& sim) {
 
 // Warm-up, memory, then `repeats` timed segments of `steps` steps of a drum or ratio scene.
 Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row row) {
-  const Scene scene = bench::settled_scene(pk, dt);
+  Scene scene = bench::settled_scene(pk, dt);
+  scene.run.spatial_sort = row.sort;
+  if (row.ids == "shuffled") {  // ids follow the order of the [[particle]] list
+    std::mt19937_64 random(7);
+    std::shuffle(scene.particles.begin(), scene.particles.end(), random);
+  }
   row.n = static_cast<std::int64_t>(pk.pos.size());
   row.drum_radius = scene.drum.radius;
   row.drum_speed = scene.drum.speed;
@@ -234,6 +259,7 @@ Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row
     row.cpu_max = std::max(row.cpu_max, cpu);
   }
   row.neighbor_builds = sim.neighbor_builds() - builds0;
+  row.sorts = sim.spatial_sorts();
   row.contacts_per_particle = static_cast<double>(sim.last_totals().contacts) / n;
   row.candidates_per_particle = static_cast<double>(sim.pairs().size()) / n;
   row.pair_contacts_per_particle = pair_contacts(sim) / n;
@@ -427,11 +453,11 @@ std::vector<T> parse_list(const std::string& s) {
 [[noreturn]] void usage(int code) {
   std::fprintf(
       code ? stderr : stdout,
-      "usage: throughput [--sections drum,ratios,block,waterfall] [--quick] [--particles "
+      "usage: throughput [--sections drum,ratios,block,waterfall,order] [--quick] [--particles "
       "N1,N2,...]\n"
       "                  [--ratios R1,R2,...] [--ratio-particles N] [--steps S] [--repeats R]\n"
       "                  [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot]\n"
-      "                  [--no-cache] [--results DIR] [--csv NAME]\n"
+      "                  [--no-cache] [--results DIR] [--csv NAME] [--order-particles N1,...]\n"
       "       throughput --profile-block STEPS | --profile-drum N STEPS [--results DIR]\n");
   std::exit(code);
 }
@@ -456,7 +482,7 @@ Options parse(int argc, char** argv) {
       o.sections.clear();
       std::stringstream in(value());
       for (std::string s; std::getline(in, s, ',');) {
-        if (s != "drum" && s != "ratios" && s != "block" && s != "waterfall") {
+        if (s != "drum" && s != "ratios" && s != "block" && s != "waterfall" && s != "order") {
           std::fprintf(stderr, "throughput: unknown section '%s'\n", s.c_str());
           usage(2);
         }
@@ -465,6 +491,8 @@ Options parse(int argc, char** argv) {
     } else if (a == "--particles") {
       o.particles = parse_list<std::int64_t>(value());
       particles_given = true;
+    } else if (a == "--order-particles") {
+      o.order_particles = parse_list<std::int64_t>(value());
     } else if (a == "--ratios") {
       o.ratios = parse_list<double>(value());
     } else if (a == "--ratio-particles") {
@@ -530,7 +558,8 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows) {
        "particle_steps_per_s_wall,ns_per_particle_step_cpu,ns_per_particle_step_wall,contacts_"
        "per_particle,neighbor_builds,settle_wall,settle_sim_time,target_particle_steps_per_s,"
        "size_ratio,repeats,cpu_max,candidates_per_particle,rss_bytes_per_particle,store_bytes_"
-       "per_particle,pair_bytes_per_particle,cost_vs_mono,pair_contacts_per_particle\n";
+       "per_particle,pair_bytes_per_particle,cost_vs_mono,pair_contacts_per_particle,ids,"
+       "spatial_sort,sorts\n";
   for (const Row& r : rows)
     f << r.section << ',' << r.n << ',' << r.drum_radius << ',' << r.drum_speed << ',' << r.dt
       << ',' << r.steps << ',' << r.wall << ',' << r.cpu << ',' << r.rate_cpu() << ','
@@ -539,7 +568,43 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows) {
       << (r.section == "block" ? kTargetBlock : kTargetRate) << ',' << r.ratio << ',' << r.repeats
       << ',' << r.cpu_max << ',' << r.candidates_per_particle << ',' << r.rss_per_particle << ','
       << r.store_per_particle << ',' << r.pairs_per_particle << ',' << r.cost_vs_mono << ','
-      << r.pair_contacts_per_particle << '\n';
+      << r.pair_contacts_per_particle << ',' << r.ids << ',' << sort_name(r.sort) << ','
+      << r.sorts << '\n';
+}
+
+// Each size with its ids as filled and shuffled, the store in id order and as "auto" chooses.
+void order_section(const Options& opt, std::vector<Row>& rows) {
+  std::printf("\n== storage order: ids as filled or shuffled; run.spatial_sort never / auto\n");
+  for (std::int64_t n : opt.order_particles) {
+    const bench::Packing pk = opt.cache ? bench::settled_packing(n, opt.results + "/cache")
+                                        : bench::settle_packing(n);
+    const auto nd = static_cast<double>(n);
+    for (const char* ids : {"fill", "shuffled"}) {
+      double never_ns = 0.0;
+      for (dem2d::SpatialSort sort : {dem2d::SpatialSort::kNever, dem2d::SpatialSort::kAuto}) {
+        Row row;
+        row.section = "order";
+        row.ratio = bench::kRadiusMax / bench::kRadiusMin;
+        row.ids = ids;
+        row.sort = sort;
+        row.steps = std::min(
+            std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
+            static_cast<std::int64_t>(opt.max_particle_steps / nd));
+        try {
+          row = measure_packing(opt, pk, 1.0e-6, row);
+        } catch (const std::exception& e) {
+          std::printf("N = %lld failed: %s\n", static_cast<long long>(n), e.what());
+          continue;
+        }
+        if (sort == dem2d::SpatialSort::kNever) never_ns = row.ns_cpu();
+        row.cost_vs_mono = never_ns > 0.0 ? row.ns_cpu() / never_ns : 0.0;
+        print_row(row, settling_of(pk));
+        std::printf("          ids %s, spatial_sort %s: %lld sorts; %.2f x the id-order cost\n",
+                    ids, sort_name(sort), static_cast<long long>(row.sorts), row.cost_vs_mono);
+        rows.push_back(row);
+      }
+    }
+  }
 }
 
 void drum_section(const Options& opt, std::vector<Row>& rows) {
@@ -618,6 +683,7 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   if (opt.has("drum")) drum_section(opt, rows);
   if (opt.has("ratios")) ratio_section(opt, rows);
+  if (opt.has("order")) order_section(opt, rows);
   if (opt.has("block")) {
     try {
       const Row b = measure_block(opt);

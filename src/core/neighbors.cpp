@@ -116,7 +116,9 @@ void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
   }
   lo_ = lo;
   int n_levels = 1;
-  while (n_levels < kMaxLevels && std::ldexp(r_min, n_levels) < r_max) ++n_levels;
+  while (levels_mode_ != Levels::kNever && n_levels < kMaxLevels &&
+         std::ldexp(r_min, n_levels) < r_max)
+    ++n_levels;
   levels_.resize(static_cast<std::size_t>(n_levels));
   level_of_.resize(n);
   for (Level& l : levels_) {
@@ -129,6 +131,12 @@ void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
     level_of_[k] = static_cast<std::int8_t>(l);
     levels_[l].r_max = std::max(levels_[l].r_max, p.radius[k]);
     ++levels_[l].count;
+  }
+  if (n_levels > 1 && levels_mode_ == Levels::kAuto && !levels_pay(hi - lo, r_max, skin)) {
+    levels_.resize(1);
+    levels_[0].r_max = r_max;
+    levels_[0].count = n;
+    std::fill(level_of_.begin(), level_of_.end(), std::int8_t{0});
   }
   for (Level& l : levels_) {
     // Cell side: the level's largest reach, enlarged if the box would need far more cells than
@@ -158,6 +166,31 @@ void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
     Level& l = levels_[level_of_[k]];
     l.items[l.fill[cell_of_[k]]++] = static_cast<int>(k);
   }
+}
+
+// Whether the levels (counts and largest radii set) need fewer cell visits and distance tests
+// than one grid sized by r_max: the expected work over the box (particles spread evenly), a
+// cell visit counted as one test. Levels pay when the small particles are many (a grinding
+// charge: fragments among balls); with as many particles per factor of radius as the small
+// ones (log-uniform radii) one grid was cheaper (bench/throughput, ratios section).
+bool NeighborSearch::levels_pay(Vec2 box, double r_max, double skin) const {
+  const auto cells = [&](double h) { return std::max(box.x, h) * std::max(box.y, h) / (h * h); };
+  double n = 0.0;
+  for (const Level& l : levels_) n += static_cast<double>(l.count);
+  const double h0 = 2.0 * r_max + skin;
+  const double single = n * 9.0 * (1.0 + n / cells(h0));
+  double levels = 0.0;
+  for (const Level& a : levels_) {
+    if (a.count == 0) continue;
+    for (const Level& b : levels_) {
+      if (b.count == 0) continue;
+      const double h = 2.0 * b.r_max + skin;
+      const double side = std::floor(2.0 * (a.r_max + b.r_max + skin) / h) + 2.0;
+      levels += static_cast<double>(a.count) * side * side *
+                (1.0 + static_cast<double>(b.count) / cells(h));
+    }
+  }
+  return levels < kLevelsGain * single;
 }
 
 // The cell of level l that holds x. A non-finite position (a run blowing up: the stability

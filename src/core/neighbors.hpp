@@ -68,6 +68,11 @@ class NeighborSearch {
       const ParticleStore& p, double cutoff_extra);
 
   std::int64_t builds() const { return builds_; }
+  // Size levels (bin_particles): as their expected work says (default), always, or never (one
+  // grid sized by the largest particle). Tests and benchmarks set it; the lists are the same.
+  enum class Levels { kAuto, kAlways, kNever };
+  void set_levels(Levels mode) { levels_mode_ = mode; }
+  int levels_used() const { return static_cast<int>(levels_.size()); }
   // The storage order's locality (core/spatial_order.hpp): the fraction of the last build's
   // pairs whose particles are more than kNear apart in storage.
   static constexpr std::int32_t kNear = 8192;
@@ -82,10 +87,13 @@ class NeighborSearch {
     Array<std::int32_t> start, items, fill;
   };
   static constexpr int kMaxLevels = 8;  // radii within a factor 2^8 of the largest share a level
+  // The levels are used when their expected work is below this share of one grid's.
+  static constexpr double kLevelsGain = 0.7;
 
   void sort_by_id(const ParticleStore& p);
   void bin_particles(const ParticleStore& p, double skin);
   std::pair<int, int> cell(const Level& l, Vec2 x) const;
+  bool levels_pay(Vec2 box, double r_max, double skin) const;
   void find_partners(const ParticleStore& p, std::int32_t i, double skin);
   void build_particle_pairs(const ParticleStore& p, double skin, PairList& out);
   void build_wall_pairs(const ParticleStore& p, const Walls& walls, double skin, WallPairList& out);
@@ -97,6 +105,7 @@ class NeighborSearch {
   Array<std::int32_t> owned_order_;  // owned indices in id order, for the store's layout_
   std::uint64_t layout_ = ~std::uint64_t{0};
   bool id_ordered_ = true;  // the owned particles are in id order
+  Levels levels_mode_ = Levels::kAuto;
   std::int64_t builds_ = 0;
   double far_fraction_ = 0.0;
 };

@@ -82,6 +82,7 @@ struct Config {
   double skin;
   bool shuffled_ids;
   bool outliers;  // a few particles far away: a huge bounding box (cells enlarged)
+  NeighborSearch::Levels levels = NeighborSearch::Levels::kAuto;
 };
 
 // Random configuration (overlaps allowed: the search does not care) of 600 particles.
@@ -140,10 +141,17 @@ void check_config(const Config& c) {
   }
 
   NeighborSearch search;
+  search.set_levels(c.levels);
   PairList pairs;
   pairs.width = 2;  // e.g. a tangential and a rolling spring
   WallPairList wall_pairs;
   search.build(p, walls, c.skin, pairs, wall_pairs);
+  if (c.levels == NeighborSearch::Levels::kNever || c.size_ratio < 2.0) {
+    EXPECT_EQ(search.levels_used(), 1);
+  } else if (c.levels == NeighborSearch::Levels::kAlways) {
+    EXPECT_EQ(search.levels_used(),
+              std::min(8, static_cast<int>(std::ceil(std::log2(c.size_ratio - 1e-9)))));
+  }
   const std::vector<IdPair> got = listed_pairs(pairs);
   const std::vector<IdPair> want = NeighborSearch::brute_force_pairs(p, c.skin);
   SCOPED_TRACE(testing::Message() << "size ratio " << c.size_ratio << ", shell "
@@ -184,6 +192,13 @@ TEST(Neighbors, CandidatesEqualBruteForceForRandomConfigurations) {
   check_config({10.0, Shell::kPolygon, 0.02, true, false});
   check_config({1.0, Shell::kNone, 0.01, true, true});
   check_config({400.0, Shell::kCircle, 0.02, true, false});
+  // Size levels forced on and off: the same lists (8 levels at 400:1, the smallest taking
+  // everything below r_max / 128).
+  for (double ratio : {3.0, 10.0, 400.0})
+    for (auto levels : {NeighborSearch::Levels::kAlways, NeighborSearch::Levels::kNever}) {
+      check_config({ratio, Shell::kCircle, 0.02, true, false, levels});
+      check_config({ratio, Shell::kNone, 0.0, false, true, levels});
+    }
   check_config({10.0, Shell::kNone, 0.0, false, true});
 }
 

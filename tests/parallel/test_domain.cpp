@@ -467,7 +467,7 @@ TEST(Reproducibility, PolydisperseChargeFillingTheDrumCentre) {
 TEST(Reproducibility, SpatiallySortedRanksMatchTheUnsortedSerialRun) {
   Scene s = polydisperse_centre_scene();
   s.title = "polydisperse, whole drum, ranks sorted in space";
-  expect_same_as_serial(s, 3000, 500, {}, false, /*sorted=*/true);
+  expect_same_as_serial(s, 6000, 1000, {}, false, /*sorted=*/true);
 }
 
 // Contacts across every wedge boundary from the first step: about 600 spheres of two radii
