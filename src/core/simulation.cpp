@@ -291,12 +291,27 @@ void Simulation::advance_clock() {
 
 void Simulation::rebuild() {
   if (step_ > 0) check_contained();
+  const bool sorted = build_lists(/*migrate=*/true);
+  // The lists just built may show that the store should be sorted (at the first build, before
+  // any list, nothing was known): then at once, and the lists built again (collective: a rank
+  // that need not sort builds again all the same).
+  if (!sorted && domain_->any(sort_policy_.due(particles_.n_owned()))) build_lists(false);
+  if (domain_->size() > 1) {
+    domain_->report_work(contacts_.particle_work(particles_.n_owned()));
+    integrator_->after_rebuild(particles_.n_owned());
+  }
+  rebuilds_.record(particles_, walls_, time_);
+}
+
+// Migration (parallel, if asked), the storage order, the ghosts, then the lists; true if the
+// store was sorted.
+bool Simulation::build_lists(bool migrate) {
   bool sorted = false;
   if (domain_->size() > 1) {
     // Particles that left this rank's region move to their owner with their contact
     // histories; then a new ghost set; the lists take their histories from the records.
     HistoryRecords records = contacts_.records();
-    domain_->migrate(particles_, records);
+    if (migrate) domain_->migrate(particles_, records);
     sorted = sort_particles();
     domain_->exchange_halo(particles_);
     contacts_.adopt(records);
@@ -305,11 +320,7 @@ void Simulation::rebuild() {
   }
   contacts_.build(particles_, walls_, rebuilds_.skin());
   sort_policy_.built(contacts_.far_fraction(), sorted);
-  if (domain_->size() > 1) {
-    domain_->report_work(contacts_.particle_work(particles_.n_owned()));
-    integrator_->after_rebuild(particles_.n_owned());
-  }
-  rebuilds_.record(particles_, walls_, time_);
+  return sorted;
 }
 
 // The owned particles in Hilbert order of cells about one particle wide, when it pays

@@ -159,6 +159,7 @@ class Simulation final : private StepStages {
   void check_contained();
   // Put the owned particles in spatial order if the policy says so; true if it did.
   bool sort_particles();
+  bool build_lists(bool migrate);
   // The resuming constructor's part: particles, histories and state from the checkpoint.
   void load_particles(const Resumption& resume);
   void resume_from(const Resumption& resume);
