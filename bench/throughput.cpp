@@ -198,8 +198,9 @@ struct Row {
 };
 
 const char* sort_name(dem2d::SpatialSort s) {
-  return s == dem2d::SpatialSort::kNever ? "never" : s == dem2d::SpatialSort::kAlways ? "always"
-                                                                                       : "auto";
+  return s == dem2d::SpatialSort::kNever    ? "never"
+         : s == dem2d::SpatialSort::kAlways ? "always"
+                                            : "auto";
 }
 
 // Touching particle-particle pairs of the pair list (the bench's own count: the core counts
@@ -568,16 +569,16 @@ void write_csv(const std::string& csv, const std::vector<Row>& rows) {
       << (r.section == "block" ? kTargetBlock : kTargetRate) << ',' << r.ratio << ',' << r.repeats
       << ',' << r.cpu_max << ',' << r.candidates_per_particle << ',' << r.rss_per_particle << ','
       << r.store_per_particle << ',' << r.pairs_per_particle << ',' << r.cost_vs_mono << ','
-      << r.pair_contacts_per_particle << ',' << r.ids << ',' << sort_name(r.sort) << ','
-      << r.sorts << '\n';
+      << r.pair_contacts_per_particle << ',' << r.ids << ',' << sort_name(r.sort) << ',' << r.sorts
+      << '\n';
 }
 
 // Each size with its ids as filled and shuffled, the store in id order and as "auto" chooses.
 void order_section(const Options& opt, std::vector<Row>& rows) {
   std::printf("\n== storage order: ids as filled or shuffled; run.spatial_sort never / auto\n");
   for (std::int64_t n : opt.order_particles) {
-    const bench::Packing pk = opt.cache ? bench::settled_packing(n, opt.results + "/cache")
-                                        : bench::settle_packing(n);
+    const bench::Packing pk =
+        opt.cache ? bench::settled_packing(n, opt.results + "/cache") : bench::settle_packing(n);
     const auto nd = static_cast<double>(n);
     for (const char* ids : {"fill", "shuffled"}) {
       double never_ns = 0.0;
@@ -587,9 +588,9 @@ void order_section(const Options& opt, std::vector<Row>& rows) {
         row.ratio = bench::kRadiusMax / bench::kRadiusMin;
         row.ids = ids;
         row.sort = sort;
-        row.steps = std::min(
-            std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
-            static_cast<std::int64_t>(opt.max_particle_steps / nd));
+        row.steps =
+            std::min(std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
+                     static_cast<std::int64_t>(opt.max_particle_steps / nd));
         try {
           row = measure_packing(opt, pk, 1.0e-6, row);
         } catch (const std::exception& e) {
