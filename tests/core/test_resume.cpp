@@ -120,28 +120,7 @@ TEST(Resume, IterativeDrumContinuesBitForBit) {
 // Ore in the drum with the balls: it breaks, is fed and leaves through the sieve before and
 // after the restart; ids, counts and the energies fed and discharged continue.
 TEST(Resume, GrindingContinuesBitForBitThroughBreakageFeedAndSieve) {
-  Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
-  MaterialSpec ore = testing_support::thesis_steel();
-  ore.name = "ore";
-  ore.density = 4800.0;
-  s.materials.push_back(ore);
-  FillSpec f = s.fills.front();
-  f.material = "ore";
-  f.count = 40;
-  f.radius_min = f.radius_max = 0.06;
-  s.fills.push_back(f);
-  s.breakage = {.present = true,
-                .material = "ore",
-                .minimum_energy = 0.01,
-                .strength = 5.0,
-                .minimum_radius = 0.035};
-  s.feed = {
-      .present = true, .material = "ore", .period = 0.02, .radius_min = 0.04, .radius_max = 0.05};
-  s.sieve = {.present = true,
-             .material = "ore",
-             .box_min = {-2.5, -2.5},
-             .box_max = {2.5, 2.5},
-             .aperture = 0.03};
+  Scene s = testing_support::grinding_drum_scene();
   Simulation original(s);
   original.run_until(0.3);
   const GrindingTotals& t = original.grinding()->totals();

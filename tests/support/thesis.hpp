@@ -74,4 +74,33 @@ inline FillSpec box_fill(const std::string& material, int count, double r_min, d
   return f;
 }
 
+// Ore in the thesis drum with 60 balls (ramp 0.1 s): 40 ore spheres of 6 cm that break (E_min
+// 0.01 J, S = 5 1/J, fragments down to 3.5 cm), a feed every 0.02 s and a sieve of aperture
+// 3 cm over the whole drum: breakage, feed and sieve all act within the first 0.3-0.4 s.
+inline Scene grinding_drum_scene() {
+  Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
+  MaterialSpec ore = thesis_steel();
+  ore.name = "ore";
+  ore.density = 4800.0;
+  s.materials.push_back(ore);
+  FillSpec f = s.fills.front();
+  f.material = "ore";
+  f.count = 40;
+  f.radius_min = f.radius_max = 0.06;
+  s.fills.push_back(f);
+  s.breakage = {.present = true,
+                .material = "ore",
+                .minimum_energy = 0.01,
+                .strength = 5.0,
+                .minimum_radius = 0.035};
+  s.feed = {
+      .present = true, .material = "ore", .period = 0.02, .radius_min = 0.04, .radius_max = 0.05};
+  s.sieve = {.present = true,
+             .material = "ore",
+             .box_min = {-2.5, -2.5},
+             .box_max = {2.5, 2.5},
+             .aperture = 0.03};
+  return s;
+}
+
 }  // namespace dem2d::testing_support
