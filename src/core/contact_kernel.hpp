@@ -14,6 +14,7 @@
 #include "core/contact_batch.hpp"
 #include "core/contact_engine.hpp"
 #include "core/contact_models.hpp"
+#include "core/pair_gather.hpp"
 
 namespace dem2d::kernels {
 
@@ -70,7 +71,9 @@ class Kernel final : public ContactKernel {
 
  public:
   Kernel(const ContactSpec& spec, const PairTable& table)
-      : n_mat_(table.n_materials()), slots_(Model::history_slots()) {
+      : n_mat_(table.n_materials()),
+        slots_(Model::history_slots()),
+        vector_gather_(kHaveVectorGather && !spec.scalar_gather) {
     for (int a = 0; a < n_mat_; ++a)
       for (int b = 0; b < n_mat_; ++b) coeffs_.push_back(Model::coeffs(table(a, b), spec));
     if (!coeffs_.empty()) uniform_ = broadcast(0);  // a scene without materials has no contacts
@@ -167,6 +170,11 @@ class Kernel final : public ContactKernel {
   std::vector<std::uint8_t> marks_;  // all zero between evaluations
   bool rescan_ = true;
   ContactBatch b_;
+  Array<std::int32_t> bi_, bj_;  // the batch's particles (local indices)
+  bool vector_gather_;
+#if DEM2D_VECTOR_GATHER
+  Array<PairKinematics> kin_;  // the vector gather's mirror of the particles
+#endif
   WallBatch wb_;
   // With the list in storage order: per entry, in contact in this evaluation; per entry, the
   // force, torque and elastic force on i (2k) and on j (2k + 1).
@@ -186,6 +194,17 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
                                   EvaluationTotals& tot) {
   constexpr std::size_t kChunk = 512;
   b_.reserve(kChunk + kPackSize);
+  if (bi_.size() < kChunk + kPackSize) {
+    bi_.resize(kChunk + kPackSize);
+    bj_.resize(kChunk + kPackSize);
+  }
+#if DEM2D_VECTOR_GATHER
+  if (vector_gather_) {
+    if (kin_.size() < p.size()) kin_.resize(p.size());
+    fill_kinematics(kin_.data(), p.pos.data(), p.vel.data(), p.omega.data(), p.radius.data(),
+                    p.mass.data(), p.material.data(), p.size());
+  }
+#endif
   if (!pl.canonical() && touch_.size() != pl.size()) {
     touch_.assign(pl.size(), 0);
     records_.resize(2 * pl.size());
@@ -285,83 +304,47 @@ void Kernel<Model>::release_ended(const ParticleStore& p, const Walls& walls, co
   });
 }
 
-// A. Gather the pairs in contact among candidates [k0, k1); pairs apart lose their history (what
-// their springs held is released: release_ended). Branch-free compaction: every candidate is
-// written to slot n and n advances only for a contact (whether a candidate touches is close to
-// random, so a branch here mispredicts often).
+// A. Gather the pairs in contact among candidates [k0, k1) (core/pair_gather.hpp); pairs apart
+// lose their history (what their springs held is released: release_ended).
 template <class Model>
 std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
                                         std::size_t k1) {
-  // Every column through a local pointer: the int32 stores below may alias any int member, so
-  // the compiler would otherwise reload n_mat_, the store's size and the columns' addresses on
-  // every iteration.
-  const Vec2* x = p.pos.data();
-  const double* r = p.radius.data();
-  const std::int32_t* li = pl.i.data();
-  const std::int32_t* lj = pl.j.data();
-  double* trial = pl.trial.data();
-  std::int32_t* pair = b_.pair.data();
-  double* dx = b_.dx.data();
-  double* dy = b_.dy.data();
-  double* dist2_out = b_.dist2.data();
+  std::fill(pl.trial.data() + k0 * W, pl.trial.data() + k1 * W, 0.0);  // the scatter rewrites
+  std::array<double*, W + 1> old{};                                    // W may be 0
+  for (std::size_t s = 0; s < W; ++s) old[s] = b_.history.old[s].data();
+  const GatherColumns cols{p.pos.data(),      p.vel.data(),
+                           p.omega.data(),    p.radius.data(),
+                           p.mass.data(),     p.material.data(),
+                           pl.i.data(),       pl.j.data(),
+                           pl.history.data(), W,
+                           p.n_owned(),       n_mat_,
+                           b_.pair.data(),    bi_.data(),
+                           bj_.data(),        b_.coeff.data(),
+                           b_.counted.data(), b_.dx.data(),
+                           b_.dy.data(),      b_.dist2.data(),
+                           b_.r_i.data(),     b_.r_j.data(),
+                           b_.m_i.data(),     b_.m_j.data(),
+                           b_.vx.data(),      b_.vy.data(),
+                           b_.spin.data(),    b_.omega_rel.data(),
+                           old.data()};
   std::size_t n = 0;
-  for (std::size_t k = k0; k < k1; ++k) {
-    const std::int32_t i = li[k], j = lj[k];
-    const Vec2 d = x[j] - x[i];
-    const double dist2 = norm2(d);
-    const double rsum = r[i] + r[j];
-    for (std::size_t s = 0; s < W; ++s) trial[k * W + s] = 0.0;  // the scatter rewrites contacts
-    pair[n] = static_cast<std::int32_t>(k);
-    dx[n] = d.x;
-    dy[n] = d.y;
-    dist2_out[n] = dist2;
-    // Written so that a NaN distance counts as a contact: its NaN forces are then caught by the
-    // stability check instead of the particle silently dropping out of every contact.
-    n += !(dist2 >= rsum * rsum) ? 1 : 0;
-  }
+#if DEM2D_VECTOR_GATHER
+  if (vector_gather_) n = gather_contacts_vector<W>(kin_.data(), cols, k0, k1);
+#endif
+  if (!vector_gather_) n = find_contacts_scalar(cols, k0, k1);
   if (!pl.canonical()) {  // apart from the loop above: a byte store there aliases everything
     std::uint8_t* touch = touch_.data();
     std::fill(touch + k0, touch + k1, std::uint8_t{0});
-    for (std::size_t c = 0; c < n; ++c) touch[pair[c]] = 1;
+    for (std::size_t c = 0; c < n; ++c) touch[b_.pair[c]] = 1;
   }
-  const Vec2* v = p.vel.data();
-  const double* w = p.omega.data();
-  const double* m = p.mass.data();
-  const std::int32_t* mat = p.material.data();
-  const double* hist = pl.history.data();
-  const std::size_t n_owned = p.n_owned();
-  const std::int32_t n_mat = n_mat_;
-  std::int32_t* coeff = b_.coeff.data();
-  double* counted = b_.counted.data();
-  double* r_i = b_.r_i.data();
-  double* r_j = b_.r_j.data();
-  double* m_i = b_.m_i.data();
-  double* m_j = b_.m_j.data();
-  double* vx = b_.vx.data();
-  double* vy = b_.vy.data();
-  double* spin = b_.spin.data();
-  double* omega_rel = b_.omega_rel.data();
-  std::array<double*, W> old{};
-  for (std::size_t s = 0; s < W; ++s) old[s] = b_.history.old[s].data();
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t k = pair[c];
-    const std::int32_t i = li[k], j = lj[k];
-    // One material: the kernel uses its one coefficient set (coeffs_of) and reads no index.
-    if (n_mat != 1) coeff[c] = mat[i] * n_mat + mat[j];
-    // A pair across a rank boundary is computed on both ranks; its energies and its count go
-    // to the rank that owns the lower-id particle (i) only.
-    counted[c] = static_cast<std::size_t>(i) < n_owned ? 1.0 : 0.0;
-    r_i[c] = r[i];
-    r_j[c] = r[j];
-    m_i[c] = m[i];
-    m_j[c] = m[j];
-    vx[c] = v[i].x - v[j].x;
-    vy[c] = v[i].y - v[j].y;
-    spin[c] = w[i] * r[i] + w[j] * r[j];
-    omega_rel[c] = w[i] - w[j];
-    for (std::size_t s = 0; s < W; ++s) old[s][c] = hist[static_cast<std::size_t>(k) * W + s];
+  if (n == 0) return 0;
+  if (!vector_gather_) gather_inputs_scalar(cols, 0, n);
+  // Padding lanes repeat the last contact.
+  for (std::size_t c = n; c < padded(n); ++c) {
+    b_.copy(c, n - 1);
+    bi_[c] = bi_[n - 1];
+    bj_[c] = bj_[n - 1];
   }
-  for (std::size_t c = n; c < padded(n); ++c) b_.copy(c, n - 1);
   return n;
 }
 
@@ -433,7 +416,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
   double* trial = pl.trial.data();
   for (std::size_t c = 0; c < n; ++c) {
     const std::int32_t k = b_.pair[c];
-    const std::int32_t i = pl.i[k], j = pl.j[k];
+    const std::int32_t i = bi_[c], j = bj_[c];
     const Vec2 fi{b_.fx[c], b_.fy[c]};
     f[i] += fi;
     f[j] -= fi;

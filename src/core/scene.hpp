@@ -79,6 +79,10 @@ struct ContactSpec {
   // The breakage tracker (peak energy, the energy now, the level tested, the birth exclusion);
   // set by the core when the scene has a [breakage] table.
   bool track_breakage = false;
+  // The pair gather's implementation: with AVX-512 eight candidates at a time (gathers and
+  // compressed stores), else one at a time. Both give the same bits; not a deck key: tests set
+  // it to compare them.
+  bool scalar_gather = false;
 };
 
 struct LifterSpec {

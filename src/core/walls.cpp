@@ -121,19 +121,8 @@ void Walls::update(double time) {
   }
 }
 
-WallGeometry Walls::geometry(int element, Vec2 x, double r) const {
-  const WallElement& e = elements_[element];
+WallGeometry Walls::segment_geometry(const WallElement& e, Vec2 x, double r) {
   WallGeometry g;
-  if (e.kind == WallKind::kCircle) {
-    // Inside a circle of radius R about the body's centre: delta = |x - c| + r - R.
-    const Vec2 c = bodies_[e.body].center + bodies_[e.body].offset;
-    const Vec2 d = x - c;
-    const double dist = norm(d);
-    g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
-    g.delta = dist + r - e.radius;
-    g.point = c + e.radius * g.n;
-    return g;
-  }
   // Segment: closest point q on [a, b]; rounded ends.
   const Vec2 ab = e.b - e.a;
   const double len2 = norm2(ab);

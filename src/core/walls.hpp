@@ -58,7 +58,21 @@ class Walls {
   Walls(const Scene& scene);  // materials resolved by name through `scene`
 
   void update(double time);  // body states and element lab positions at `time`
-  WallGeometry geometry(int element, Vec2 x, double r) const;
+  // Inline for the circle (the drum's shell: most wall contacts of a round mill), the segment
+  // out of line.
+  WallGeometry geometry(int element, Vec2 x, double r) const {
+    const WallElement& e = elements_[element];
+    if (e.kind != WallKind::kCircle) return segment_geometry(e, x, r);
+    // Inside a circle of radius R about the body's centre: delta = |x - c| + r - R.
+    WallGeometry g;
+    const Vec2 c = bodies_[e.body].center + bodies_[e.body].offset;
+    const Vec2 d = x - c;
+    const double dist = norm(d);
+    g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
+    g.delta = dist + r - e.radius;
+    g.point = c + e.radius * g.n;
+    return g;
+  }
   // Whether a sphere at x of radius r overlaps the element (geometry(...).delta > 0) without
   // the square root and division of the full geometry: the cheap test of the force kernel.
   bool touches(int element, Vec2 x, double r) const {
@@ -92,6 +106,7 @@ class Walls {
   double drum_speed() const { return has_drum() ? bodies_[drum_body_].speed : 0.0; }
 
  private:
+  static WallGeometry segment_geometry(const WallElement& e, Vec2 x, double r);
   std::vector<WallBody> bodies_;
   std::vector<WallElement> elements_;
   int drum_body_ = -1;

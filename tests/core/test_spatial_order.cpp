@@ -7,18 +7,19 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <functional>
 #include <map>
 #include <set>
 
 #include "core/simulation.hpp"
 #include "core/spatial_order.hpp"
+#include "support/compare.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
 
+using testing_support::expect_same_particles;
 using testing_support::thesis_drum_scene;
 
 TEST(SpatialOrder, HilbertCurveVisitsEveryCellOnceByAdjacentSteps) {
@@ -38,30 +39,6 @@ TEST(SpatialOrder, HilbertCurveVisitsEveryCellOnceByAdjacentSteps) {
           << "bits " << bits << ", step " << d;
       prev = xy;
     }
-  }
-}
-
-// Every field of every particle, bit for bit, matched by id.
-void expect_same_particles(const Simulation& a, const Simulation& b) {
-  const ParticleStore& p = a.particles();
-  const ParticleStore& q = b.particles();
-  ASSERT_EQ(p.n_owned(), q.n_owned());
-  std::map<std::int64_t, std::size_t> in_q;
-  for (std::size_t k = 0; k < q.n_owned(); ++k) in_q[q.id[k]] = k;
-  for (std::size_t f = 0; f < p.fields().size(); ++f) {
-    const FieldBase& fa = *p.fields()[f];
-    const FieldBase& fb = *q.fields()[f];
-    ASSERT_EQ(fa.name(), fb.name());
-    const std::size_t w = fa.bytes_per_item();
-    std::vector<std::byte> x(w), y(w);
-    int differ = 0;
-    for (std::size_t m = 0; m < p.n_owned(); ++m) {
-      ASSERT_TRUE(in_q.contains(p.id[m])) << "particle " << p.id[m];
-      fa.pack(m, x.data());
-      fb.pack(in_q[p.id[m]], y.data());
-      differ += std::memcmp(x.data(), y.data(), w) != 0;
-    }
-    EXPECT_EQ(differ, 0) << "field " << fa.name();
   }
 }
 
