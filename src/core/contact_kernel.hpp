@@ -312,20 +312,35 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
   std::fill(pl.trial.data() + k0 * W, pl.trial.data() + k1 * W, 0.0);  // the scatter rewrites
   std::array<double*, W + 1> old{};                                    // W may be 0
   for (std::size_t s = 0; s < W; ++s) old[s] = b_.history.old[s].data();
-  const GatherColumns cols{p.pos.data(),      p.vel.data(),
-                           p.omega.data(),    p.radius.data(),
-                           p.mass.data(),     p.material.data(),
-                           pl.i.data(),       pl.j.data(),
-                           pl.history.data(), W,
-                           p.n_owned(),       n_mat_,
-                           b_.pair.data(),    bi_.data(),
-                           bj_.data(),        b_.coeff.data(),
-                           b_.counted.data(), b_.dx.data(),
-                           b_.dy.data(),      b_.dist2.data(),
-                           b_.r_i.data(),     b_.r_j.data(),
-                           b_.m_i.data(),     b_.m_j.data(),
-                           b_.vx.data(),      b_.vy.data(),
-                           b_.spin.data(),    b_.omega_rel.data(),
+  const GatherColumns cols{p.pos.data(),
+                           p.vel.data(),
+                           p.omega.data(),
+                           p.radius.data(),
+                           p.mass.data(),
+                           p.material.data(),
+                           pl.i.data(),
+                           pl.j.data(),
+                           pl.size(),
+                           pl.history.data(),
+                           W,
+                           p.n_owned(),
+                           n_mat_,
+                           b_.pair.data(),
+                           bi_.data(),
+                           bj_.data(),
+                           b_.coeff.data(),
+                           b_.counted.data(),
+                           b_.dx.data(),
+                           b_.dy.data(),
+                           b_.dist2.data(),
+                           b_.r_i.data(),
+                           b_.r_j.data(),
+                           b_.m_i.data(),
+                           b_.m_j.data(),
+                           b_.vx.data(),
+                           b_.vy.data(),
+                           b_.spin.data(),
+                           b_.omega_rel.data(),
                            old.data()};
   std::size_t n = 0;
 #if DEM2D_VECTOR_GATHER
@@ -414,9 +429,21 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
   double* trial = pl.trial.data();
+  const std::int32_t* bj = bj_.data();
+  // The partner's three lines kAhead contacts ahead (the lower-id particles come in order), where
+  // the store is past the caches: at 1e5 particles the scatter waited on them (whole run 0.94x
+  // with the prefetch), at 3e4 the prefetch cost 4 % (bench/throughput, paired runs).
+  constexpr std::size_t kAhead = 16, kPrefetchFrom = 50000;
+  const std::size_t ahead = p.size() >= kPrefetchFrom ? kAhead : n;
   for (std::size_t c = 0; c < n; ++c) {
+    if (c + ahead < n) {
+      const std::int32_t next = bj[c + ahead];
+      __builtin_prefetch(f + next, 1);
+      __builtin_prefetch(tq + next, 1);
+      __builtin_prefetch(f_el + next, 1);
+    }
     const std::int32_t k = b_.pair[c];
-    const std::int32_t i = bi_[c], j = bj_[c];
+    const std::int32_t i = bi_[c], j = bj[c];
     const Vec2 fi{b_.fx[c], b_.fy[c]};
     f[i] += fi;
     f[j] -= fi;

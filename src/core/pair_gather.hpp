@@ -40,6 +40,7 @@ struct GatherColumns {
   const std::int32_t* material;
   const std::int32_t* li;  // the list's particles
   const std::int32_t* lj;
+  std::size_t entries;    // the list's length
   const double* history;  // the list's committed history, `width` values per entry
   std::size_t width;
   std::size_t n_owned;
@@ -217,6 +218,8 @@ template <std::size_t W>
 // Both steps of the scalar forms at once, eight candidates at a time: the candidates [k0, k1) in
 // contact and their inputs, packed into the columns from 0 on; returns their count. W: the
 // history width.
+inline constexpr std::size_t kPrefetch = 64;
+
 template <std::size_t W>
 inline std::size_t gather_contacts_vector(const PairKinematics* kin, const GatherColumns& cols,
                                           std::size_t k0, std::size_t k1) {
@@ -240,6 +243,11 @@ inline std::size_t gather_contacts_vector(const PairKinematics* kin, const Gathe
       pj = tail_j;
     }
     const __mmask8 live = static_cast<__mmask8>((1u << count) - 1u);
+    // The partners' lines kPrefetch candidates ahead (the lower-id particles come in order and
+    // the hardware finds them): 0.75 of the run time of the 1e5 drum, whose mirror is past L2.
+    if (k + kPrefetch + 8 <= o.entries)
+      for (std::size_t l = 0; l < 8; ++l)
+        _mm_prefetch(reinterpret_cast<const char*>(&kin[o.lj[k + kPrefetch + l]]), _MM_HINT_T0);
     __m512d a[8], b[8];
     for (std::size_t l = 0; l < 8; ++l) {
       a[l] = _mm512_load_pd(&kin[pi[l]].x);
