@@ -82,10 +82,9 @@ void NeighborSearch::sort_by_id(const ParticleStore& p) {
   if (layout_ != p.layout() || owned_order_.size() != n_owned) {
     owned_order_.resize(n_owned);
     std::iota(owned_order_.begin(), owned_order_.end(), 0);
-    if (!std::is_sorted(p.id.data(), p.id.data() + n_owned))
-      std::sort(owned_order_.begin(), owned_order_.end(), by_id);
-    layout_ = p.layout();
     id_ordered_ = std::is_sorted(p.id.data(), p.id.data() + n_owned);
+    if (!id_ordered_) std::sort(owned_order_.begin(), owned_order_.end(), by_id);
+    layout_ = p.layout();
   }
   order_.resize(n);
   std::copy(owned_order_.begin(), owned_order_.end(), order_.begin());
@@ -97,12 +96,12 @@ void NeighborSearch::sort_by_id(const ParticleStore& p) {
                      order_.end(), by_id);
 }
 
-// Counting sort of the particles (owned and ghosts) into one grid per size level. Level l holds
-// the radii in (r_max / 2^(l+1), r_max / 2^l] (the last level everything smaller), and its cells
-// have a side of at least its largest reach 2 R_l + skin, so a particle finds its partners of
-// level l in the few cells within r_i + R_l + skin. One level (size ratio below 2) is the plain
-// cell grid; with a wide size range a small particle no longer scans cells sized for the
-// largest ones (up to a hundred small particles each at 10:1).
+// Counting sort of the particles (owned and ghosts) into one grid per size level, when levels
+// are used (levels_pay; otherwise one level: the plain cell grid). Level l holds the radii in
+// (r_max / 2^(l+1), r_max / 2^l] (the last level everything smaller), and its cells have a side
+// of at least its largest reach 2 R_l + skin, so a particle finds its partners of level l in the
+// few cells within r_i + R_l + skin. With a wide size range a small particle then no longer
+// scans cells sized for the largest ones (up to a hundred small particles each at 10:1).
 void NeighborSearch::bin_particles(const ParticleStore& p, double skin) {
   const std::size_t n = p.size();
   double r_max = 0.0, r_min = std::numeric_limits<double>::max();
