@@ -89,13 +89,7 @@ TEST(PairGather, VectorGatherChangesNoBitOfASortedStore) {
 }
 
 TEST(PairGather, VectorGatherChangesNoBitWithATenToOneSizeRange) {
-  Scene s = thesis_drum_scene(10, 3.0, 8, 0.0);
-  s.drum.radius = 0.4;
-  s.fills.front().count = 200;
-  s.fills.front().region = FillRegion::kFull;
-  s.fills.front().radius_min = 0.002;
-  s.fills.front().radius_max = 0.02;
-  expect_vector_gather_changes_nothing(s, 0.2);
+  expect_vector_gather_changes_nothing(testing_support::ten_to_one_drum_scene(), 0.2);
 }
 
 }  // namespace

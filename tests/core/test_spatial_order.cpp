@@ -84,12 +84,7 @@ TEST(SpatialOrder, SortingChangesNoBitOfTheIterativeScheme) {
 
 // Balls of 2-20 mm radius (four search levels) stirred by an 8-sided drum.
 TEST(SpatialOrder, SortingChangesNoBitWithATenToOneSizeRange) {
-  Scene s = thesis_drum_scene(10, 3.0, 8, 0.0);
-  s.drum.radius = 0.4;
-  s.fills.front().count = 200;
-  s.fills.front().region = FillRegion::kFull;
-  s.fills.front().radius_min = 0.002;
-  s.fills.front().radius_max = 0.02;
+  const Scene s = testing_support::ten_to_one_drum_scene();
   Simulation probe(s);
   ASSERT_EQ(probe.particles().n_owned(), 200u);
   expect_sorting_changes_nothing(s, 0.4);

@@ -103,4 +103,16 @@ inline Scene grinding_drum_scene() {
   return s;
 }
 
+// 200 balls of 2-20 mm radius (a 10:1 size range: four search levels) filling a 0.4 m drum of
+// 8 sides that stirs them at 3 rad/s.
+inline Scene ten_to_one_drum_scene() {
+  Scene s = thesis_drum_scene(10, 3.0, 8, 0.0);
+  s.drum.radius = 0.4;
+  s.fills.front().count = 200;
+  s.fills.front().region = FillRegion::kFull;
+  s.fills.front().radius_min = 0.002;
+  s.fills.front().radius_max = 0.02;
+  return s;
+}
+
 }  // namespace dem2d::testing_support
