@@ -48,6 +48,16 @@
 // under its own weight would take tens of ms (a compression wave over 10 m of spheres,
 // several passes: 3e4-5e4 steps of 1e6 particles, about an hour of CPU), which was not done.
 // So the tiled sizes have the candidate pairs of a settled bed but a third of its contacts.
+// Two cheaper loadings were tried (2026-11-26, third session) and dropped:
+//  - stage 3 in steel with e = 0.1: 1.39 contacts per particle after 1000 steps, then 0.93,
+//    0.56, 0.28, 0.13 after 2000-5000 steps while the mean speed grew by about 1 cm/s per ms
+//    (free fall at ~g): the copies meet along ragged edges with voids between them, and the
+//    layers above each seam fall into them. Closing them by falling takes ~0.1 s (1e5 steps).
+//  - lowering each particle straight down, from the lowest up, onto the particles below it
+//    before stage 3 (no voids, contacts at zero overlap): 0.76, 0.51, 0.36, 0.33 contacts per
+//    particle after 1000-4000 steps, the mean speed again growing ~1 cm/s per ms: most
+//    particles then rest on one sphere instead of in a pocket, and with mu_s = 0.1 they roll off
+//    it. A gap-free tiling would need each particle rolled into a pocket of two supports.
 //
 // The size-ratio charges (settle_ratio_packing, bench/throughput's "ratios" section): N spheres
 // of the same steel with radii log-uniform between r_max / ratio and r_max = 10 mm (the

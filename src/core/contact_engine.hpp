@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/contact_history.hpp"
+#include "core/kinematics_mirror.hpp"
 #include "core/materials.hpp"
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
@@ -54,6 +55,9 @@ class ContactKernel {
   // The last evaluation's histories were committed / the lists were rebuilt or replaced.
   virtual void committed() = 0;
   virtual void lists_changed() = 0;
+  // The pair gather's mirror lines of the owned particles, for the drift about to run to write
+  // (core/kinematics_mirror.hpp); nullptr when this kernel keeps no mirror.
+  virtual PairKinematics* drift_mirror(const ParticleStore&) { return nullptr; }
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.
@@ -74,6 +78,8 @@ class ContactEngine {
   // Forces of every listed contact for the current state; histories advanced by dt into the
   // trial slots (dt = 0: at rest in time). The force accumulators are added to, not cleared.
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
+  // See ContactKernel::drift_mirror.
+  PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
   const EvaluationTotals& totals() const { return totals_; }
   // The trial histories become the committed ones.
   void commit();

@@ -100,6 +100,16 @@ class Kernel final : public ContactKernel {
     live_walls_.swap(next_live_walls_);
   }
   void lists_changed() override { rescan_ = true; }
+  PairKinematics* drift_mirror(const ParticleStore& p) override {
+#if DEM2D_VECTOR_GATHER
+    if (vector_gather_) {
+      kin_.expect_owned(p.layout());
+      return kin_.lines(p.n_owned());
+    }
+#endif
+    static_cast<void>(p);
+    return nullptr;
+  }
 
  private:
   typename Model::template Coeffs<Pack> broadcast(std::int32_t k) const {
@@ -173,7 +183,7 @@ class Kernel final : public ContactKernel {
   Array<std::int32_t> bi_, bj_;  // the batch's particles (local indices)
   bool vector_gather_;
 #if DEM2D_VECTOR_GATHER
-  Array<PairKinematics> kin_;  // the vector gather's mirror of the particles
+  KinematicsMirror kin_;  // the vector gather's mirror of the particles
 #endif
   WallBatch wb_;
   // With the list in storage order: per entry, in contact in this evaluation; per entry, the
@@ -200,9 +210,9 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
   }
 #if DEM2D_VECTOR_GATHER
   if (vector_gather_) {
-    if (kin_.size() < p.size()) kin_.resize(p.size());
-    fill_kinematics(kin_.data(), p.pos.data(), p.vel.data(), p.omega.data(), p.radius.data(),
-                    p.mass.data(), p.material.data(), p.size());
+    fill_kinematics(kin_.lines(p.size()), p.pos.data(), p.vel.data(), p.omega.data(),
+                    p.radius.data(), p.mass.data(), p.material.data(),
+                    kin_.fresh_lines(p.layout(), p.n_owned()), p.size());
   }
 #endif
   if (!pl.canonical() && touch_.size() != pl.size()) {
@@ -344,7 +354,7 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
                            .old = old.data()};
   std::size_t n = 0;
 #if DEM2D_VECTOR_GATHER
-  if (vector_gather_) n = gather_contacts_vector<W>(kin_.data(), cols, k0, k1);
+  if (vector_gather_) n = gather_contacts_vector<W>(kin_.lines(0), cols, k0, k1);
 #endif
   if (!vector_gather_) n = find_contacts_scalar(cols, k0, k1);
   if (!pl.canonical()) {  // apart from the loop above: a byte store there aliases everything

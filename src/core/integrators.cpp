@@ -58,7 +58,7 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
     std::fill(p.elastic_force.data(), p.elastic_force.data() + p.n_owned(), Vec2{});
     elastic_cleared_ = true;
   }
-  kick_drift_owned(p);  // v += a dt/2, x += v dt; force accumulators cleared
+  kick_drift_owned(p, s.drift_mirror());  // v += a dt/2, x += v dt; accumulators cleared
   s.advance_clock();
   if (rebuild_next_)  // decided in the previous step's round
     s.rebuild();
@@ -72,7 +72,9 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
   return end_of_step_round(s, closing);
 }
 
-void VelocityVerlet::kick_drift_owned(ParticleStore& p) const {
+// The drift also writes the pair gather's mirror lines when the contact loop keeps them
+// (`mirror`, core/kinematics_mirror.hpp): a second pass over the store would re-read it.
+void VelocityVerlet::kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const {
   const double h = 0.5 * dt_;
   Vec2* x = p.pos.data();
   Vec2* v = p.vel.data();
@@ -82,15 +84,31 @@ void VelocityVerlet::kick_drift_owned(ParticleStore& p) const {
   const double* al = p.alpha.data();
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
-  for (std::size_t k = 0; k < p.n_owned(); ++k) {
-    const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt_);
-    x[k] = d.x;
-    v[k] = d.v;
-    w[k] = d.w;
-    th[k] += dt_ * d.w;
-    f[k] = {};
-    tq[k] = 0.0;
+  const std::size_t n = p.n_owned();
+  const auto drift = [&](auto write_line) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt_);
+      x[k] = d.x;
+      v[k] = d.v;
+      w[k] = d.w;
+      th[k] += dt_ * d.w;
+      f[k] = {};
+      tq[k] = 0.0;
+      write_line(k, d);
+    }
+  };
+#if DEM2D_VECTOR_GATHER
+  if (mirror) {
+    const double* r = p.radius.data();
+    const double* m = p.mass.data();
+    const std::int32_t* mat = p.material.data();
+    return drift([&](std::size_t k, const Drifted& d) {
+      store_kinematics(mirror[k], d.x, d.v, d.w, r[k], m[k], mat[k]);
+    });
   }
+#endif
+  static_cast<void>(mirror);
+  drift([](std::size_t, const Drifted&) {});
 }
 
 // The closing half kick fused with the accelerations, and the two maxima of the next step's

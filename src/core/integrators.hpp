@@ -67,6 +67,9 @@ class StepStages {
   // Contact forces and torques at the current state into the accumulators (cleared first, the
   // owned ones unless `owned_cleared`); histories advanced by dt into the trial slots.
   virtual void contact_forces(double dt, bool owned_cleared) = 0;
+  // Lines for the drift about to run to write the owned particles' new state into, read by the
+  // next contact_forces (core/kinematics_mirror.hpp); nullptr when the contact loop keeps none.
+  virtual PairKinematics* drift_mirror() = 0;
   // The trial histories become the committed ones; the step's energies are booked, with
   // `late_loss` (J) added to the dissipation the contact laws reported (Verlet's completion of
   // their work to the end-of-step velocity).
@@ -180,7 +183,7 @@ class VelocityVerlet final : public Integrator {
     double motion2 = 0.0;              // max |v + a dt/2|^2 / r^2 (owned)
     double late_loss = 0.0;            // J, see closing_kick
   };
-  void kick_drift_owned(ParticleStore& p) const;
+  void kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const;
   Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
   void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
   StepOutcome end_of_step_round(StepStages& s, const Closing& c);

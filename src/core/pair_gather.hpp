@@ -15,14 +15,9 @@
 #include <cstdint>
 #include <limits>
 
+#include "core/kinematics_mirror.hpp"
 #include "core/simd.hpp"
 #include "core/vec2.hpp"
-
-#if defined(__AVX512F__) && defined(__AVX512VL__)
-#define DEM2D_VECTOR_GATHER 1
-#else
-#define DEM2D_VECTOR_GATHER 0
-#endif
 
 namespace dem2d::kernels {
 
@@ -111,24 +106,12 @@ inline void gather_inputs_scalar(const GatherColumns& o, std::size_t c0, std::si
 
 #if DEM2D_VECTOR_GATHER
 
-// One particle's data for the vector gather, in one cache line: a candidate's two particles are
-// two aligned loads, and eight candidates' loads transposed give the columns (AMD's gather
-// instructions load no faster than scalar loads: measured 7 % against 36 % of the block's time).
-struct alignas(64) PairKinematics {
-  double x, y, vx, vy, w, r, m, material;
-};
-
-// The mirror of the store's particles [0, n), refreshed before each pair loop.
+// The mirror's lines [from, n) from the store (core/kinematics_mirror.hpp).
 inline void fill_kinematics(PairKinematics* out, const Vec2* x, const Vec2* v, const double* w,
                             const double* r, const double* m, const std::int32_t* material,
-                            std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) {  // two 32-byte halves (the compiler's own was 3x slower)
-    const __m256d motion = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(&x[i].x)),
-                                                _mm_loadu_pd(&v[i].x), 1);
-    const __m256d body = _mm256_setr_pd(w[i], r[i], m[i], static_cast<double>(material[i]));
-    _mm256_store_pd(&out[i].x, motion);
-    _mm256_store_pd(&out[i].w, body);
-  }
+                            std::size_t from, std::size_t n) {
+  for (std::size_t i = from; i < n; ++i)
+    store_kinematics(out[i], x[i], v[i], w[i], r[i], m[i], material[i]);
 }
 
 // Eight rows of eight doubles to eight columns (a[f] lane l = row l's field f).

@@ -151,6 +151,7 @@ class Simulation final : private StepStages {
   void refresh_ghosts() override;
   std::span<FieldBase* const> ghost_fields() override { return ghost_fields_; }
   void contact_forces(double dt, bool owned_cleared) override;
+  PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
   void commit(double dt, double late_loss) override;
 
   void choose_dt();
