@@ -72,43 +72,40 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
   return end_of_step_round(s, closing);
 }
 
+namespace {
+
+// The opening half kick and drift of particles [0, n), and with kMirror their pair-gather mirror
+// lines, read back from the store just written (pointers as arguments: captured by a lambda they
+// ran out of registers).
+template <bool kMirror>
+void drift_particles(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const Vec2* a,
+                     double* th, double* w, const double* al, Vec2* f, double* tq,
+                     [[maybe_unused]] const double* r, [[maybe_unused]] const double* m,
+                     [[maybe_unused]] const std::int32_t* mat,
+                     [[maybe_unused]] PairKinematics* mirror) {
+  for (std::size_t k = 0; k < n; ++k) {
+    const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt);
+    x[k] = d.x;
+    v[k] = d.v;
+    w[k] = d.w;
+    th[k] += dt * d.w;
+    f[k] = {};
+    tq[k] = 0.0;
+#if DEM2D_VECTOR_GATHER
+    if constexpr (kMirror) store_kinematics(mirror[k], x[k], v[k], d.w, r[k], m[k], mat[k]);
+#endif
+  }
+}
+
+}  // namespace
+
 // The drift also writes the pair gather's mirror lines when the contact loop keeps them
 // (`mirror`, core/kinematics_mirror.hpp): a second pass over the store would re-read it.
 void VelocityVerlet::kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const {
-  const double h = 0.5 * dt_;
-  Vec2* x = p.pos.data();
-  Vec2* v = p.vel.data();
-  const Vec2* a = p.acc.data();
-  double* th = p.theta.data();
-  double* w = p.omega.data();
-  const double* al = p.alpha.data();
-  Vec2* f = p.force.data();
-  double* tq = p.torque.data();
-  const std::size_t n = p.n_owned();
-  const auto drift = [&](auto write_line) {
-    for (std::size_t k = 0; k < n; ++k) {
-      const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt_);
-      x[k] = d.x;
-      v[k] = d.v;
-      w[k] = d.w;
-      th[k] += dt_ * d.w;
-      f[k] = {};
-      tq[k] = 0.0;
-      write_line(k, d);
-    }
-  };
-#if DEM2D_VECTOR_GATHER
-  if (mirror) {
-    const double* r = p.radius.data();
-    const double* m = p.mass.data();
-    const std::int32_t* mat = p.material.data();
-    return drift([&](std::size_t k, const Drifted& d) {
-      store_kinematics(mirror[k], d.x, d.v, d.w, r[k], m[k], mat[k]);
-    });
-  }
-#endif
-  static_cast<void>(mirror);
-  drift([](std::size_t, const Drifted&) {});
+  const auto drift = mirror ? drift_particles<true> : drift_particles<false>;
+  drift(p.n_owned(), 0.5 * dt_, dt_, p.pos.data(), p.vel.data(), p.acc.data(), p.theta.data(),
+        p.omega.data(), p.alpha.data(), p.force.data(), p.torque.data(), p.radius.data(),
+        p.mass.data(), p.material.data(), mirror);
 }
 
 // The closing half kick fused with the accelerations, and the two maxima of the next step's
