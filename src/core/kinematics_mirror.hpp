@@ -17,11 +17,13 @@
 #include <cstdint>
 
 #include "core/array.hpp"
-#include "core/simd.hpp"
 #include "core/vec2.hpp"
 
 #if defined(__AVX512F__) && defined(__AVX512VL__)
 #define DEM2D_VECTOR_GATHER 1
+// The intrinsics alone: this header reaches code built by clang too (the fuzz build of the deck
+// reader), which core/simd.hpp's std::experimental::simd must not.
+#include "core/intrinsics.hpp"
 #else
 #define DEM2D_VECTOR_GATHER 0
 #endif

@@ -7,14 +7,11 @@
 
 #include <algorithm>
 #include <cmath>
-// GCC 12 reports -Wmaybe-uninitialized inside its own AVX-512 intrinsics (the deliberately
-// undefined pass-through operand of _mm512_sqrt_pd and friends) wherever a pack function is
-// inlined into our code; the location is the system header, so the warning is silenced for the
-// header's lines only and stays on for ours.
+
+#include "core/intrinsics.hpp"
+// The same warning as in core/intrinsics.hpp, from the simd header's lines.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include <immintrin.h>
-
 #include <experimental/simd>
 #pragma GCC diagnostic pop
 
