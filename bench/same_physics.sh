@@ -9,7 +9,8 @@
 # commit in a second work tree (git worktree add ../old <commit>), then run this script with
 # both binaries. RANKS (default 1) is the rank count of both runs; the new binary at another
 # rank count must agree too (the decomposition is bit-identical at any rank count). Prints one
-# line per deck and exits 1 when any deck differs. NEW_ARGS (environment) is added to the new
+# line per deck and exits 1 when any deck's snapshots differ; a series.csv that differs is
+# reported with its largest difference (the column, relative to the column's largest value). NEW_ARGS (environment) is added to the new
 # binary's command line, e.g. NEW_ARGS="--set run.spatial_sort=always" to compare a store
 # sorted at every rebuild with the old binary's id order.
 set -u
@@ -30,6 +31,29 @@ run() {
   else
     "$bin" --quiet --output "$dir" "${extra[@]}" "$deck" > "$dir.log" 2>&1
   fi
+}
+# The column of series.csv that differs most, relative to that column's largest magnitude.
+series_difference() {
+  /usr/bin/python3 - "$1" "$2" <<'PY'
+import csv, math, sys
+a, b = (list(csv.DictReader(open(f))) for f in sys.argv[1:3])
+if len(a) != len(b):
+    print(f"{len(a)} rows against {len(b)}")
+    sys.exit()
+worst, where = 0.0, "none"
+for col in a[0]:
+    try:
+        x = [float(r[col]) for r in a]
+        y = [float(r[col]) for r in b]
+    except ValueError:
+        continue
+    scale = max((abs(v) for v in x if math.isfinite(v)), default=0.0) or 1.0
+    d = max((abs(u - v) for u, v in zip(x, y) if math.isfinite(u) and math.isfinite(v)),
+            default=0.0) / scale
+    if d > worst:
+        worst, where = d, col
+print(f"largest {worst:.1e} of the column's scale in {where}")
+PY
 }
 mkdir -p "$out"
 differ=0
@@ -52,7 +76,8 @@ for deck in "$src"/inputs/*.in; do
   if cmp -s "$out/old_$name/series.csv" "$out/new_$name/series.csv"; then
     result="$result, series.csv identical"
   else
-    result="$result, series.csv differs"
+    result="$result, series.csv differs: $(series_difference "$out/old_$name/series.csv" \
+      "$out/new_$name/series.csv")"
   fi
   printf '%-22s %8.2f %8.2f  %s\n' "$name" "$(echo "$t1 - $t0" | bc)" "$(echo "$t2 - $t1" | bc)" "$result"
 done
