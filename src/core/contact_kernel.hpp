@@ -354,7 +354,7 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
                            .old = old.data()};
   std::size_t n = 0;
 #if DEM2D_VECTOR_GATHER
-  if (vector_gather_) n = gather_contacts_vector<W>(kin_.lines(0), cols, k0, k1);
+  if (vector_gather_) n = gather_contacts_vector<W>(kin_.data(), cols, k0, k1);
 #endif
   if (!vector_gather_) n = find_contacts_scalar(cols, k0, k1);
   if (!pl.canonical()) {  // apart from the loop above: a byte store there aliases everything

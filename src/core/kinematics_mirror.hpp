@@ -55,6 +55,7 @@ class KinematicsMirror {
     if (lines_.size() < n) lines_.resize(n);
     return lines_.data();
   }
+  const PairKinematics* data() const { return lines_.data(); }
   // The drift about to run writes lines [0, n_owned) of this storage layout.
   void expect_owned(std::uint64_t layout) {
     claim_ = layout;
