@@ -77,13 +77,69 @@ namespace {
 // The opening half kick and drift of particles [0, n), and with kMirror their pair-gather mirror
 // lines, read back from the store just written (pointers as arguments: captured by a lambda they
 // ran out of registers).
+#if DEM2D_VECTOR_GATHER
+// Particles [0, 4 floor(n / 4)) of drift_particles, four at a time: the same multiplications and
+// additions in the same order (no FMA contraction), so the same bits; returns where it stopped.
+// The scalar loop took 37 instructions per particle (9 % of the dense block's time).
+template <bool kMirror>
+std::size_t drift_fours(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const Vec2* a,
+                        double* th, double* w, const double* al, Vec2* f, double* tq,
+                        [[maybe_unused]] const double* r, [[maybe_unused]] const double* m,
+                        [[maybe_unused]] const std::int32_t* mat,
+                        [[maybe_unused]] PairKinematics* mirror) {
+  const __m512d h8 = _mm512_set1_pd(h), dt8 = _mm512_set1_pd(dt);
+  const __m256d h4 = _mm256_set1_pd(h), dt4 = _mm256_set1_pd(dt);
+  std::size_t k = 0;
+  for (; k + 4 <= n; k += 4) {
+    // Vec2 columns: (x, y) of four particles in one register.
+    const __m512d v_half =
+        _mm512_add_pd(_mm512_loadu_pd(&v[k].x), _mm512_mul_pd(h8, _mm512_loadu_pd(&a[k].x)));
+    const __m512d x_new = _mm512_add_pd(_mm512_loadu_pd(&x[k].x), _mm512_mul_pd(dt8, v_half));
+    const __m256d w_new =
+        _mm256_add_pd(_mm256_loadu_pd(w + k), _mm256_mul_pd(h4, _mm256_loadu_pd(al + k)));
+    _mm512_storeu_pd(&x[k].x, x_new);
+    _mm512_storeu_pd(&v[k].x, v_half);
+    _mm256_storeu_pd(w + k, w_new);
+    _mm256_storeu_pd(th + k, _mm256_add_pd(_mm256_loadu_pd(th + k), _mm256_mul_pd(dt4, w_new)));
+    _mm512_storeu_pd(&f[k].x, _mm512_setzero_pd());
+    _mm256_storeu_pd(tq + k, _mm256_setzero_pd());
+    if constexpr (kMirror) {
+      // Lines (x, y, vx, vy | w, r, m, material): motion halves of particles 0|1 and 2|3, then
+      // the other halves, then each line from its two halves.
+      const __m512d motion01 =
+          _mm512_permutex2var_pd(x_new, _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), v_half);
+      const __m512d motion23 =
+          _mm512_permutex2var_pd(x_new, _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15), v_half);
+      const __m512d wr =
+          _mm512_insertf64x4(_mm512_castpd256_pd512(w_new), _mm256_loadu_pd(r + k), 1);
+      const __m512d mm = _mm512_insertf64x4(
+          _mm512_castpd256_pd512(_mm256_loadu_pd(m + k)),
+          _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(mat + k))), 1);
+      const __m512d body01 =
+          _mm512_permutex2var_pd(wr, _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13), mm);
+      const __m512d body23 =
+          _mm512_permutex2var_pd(wr, _mm512_setr_epi64(2, 6, 10, 14, 3, 7, 11, 15), mm);
+      _mm512_store_pd(&mirror[k].x, _mm512_shuffle_f64x2(motion01, body01, 0x44));
+      _mm512_store_pd(&mirror[k + 1].x, _mm512_shuffle_f64x2(motion01, body01, 0xEE));
+      _mm512_store_pd(&mirror[k + 2].x, _mm512_shuffle_f64x2(motion23, body23, 0x44));
+      _mm512_store_pd(&mirror[k + 3].x, _mm512_shuffle_f64x2(motion23, body23, 0xEE));
+    }
+  }
+  return k;
+}
+#endif
+
 template <bool kMirror>
 void drift_particles(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const Vec2* a,
                      double* th, double* w, const double* al, Vec2* f, double* tq,
                      [[maybe_unused]] const double* r, [[maybe_unused]] const double* m,
                      [[maybe_unused]] const std::int32_t* mat,
-                     [[maybe_unused]] PairKinematics* mirror) {
-  for (std::size_t k = 0; k < n; ++k) {
+                     [[maybe_unused]] PairKinematics* mirror, [[maybe_unused]] bool fours) {
+  std::size_t from = 0;
+#if DEM2D_VECTOR_GATHER
+  if (fours) from = drift_fours<kMirror>(n, h, dt, x, v, a, th, w, al, f, tq, r, m, mat, mirror);
+#endif
+  for (std::size_t k = from; k < n; ++k) {
     const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt);
     x[k] = d.x;
     v[k] = d.v;
@@ -101,11 +157,15 @@ void drift_particles(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const
 
 // The drift also writes the pair gather's mirror lines when the contact loop keeps them
 // (`mirror`, core/kinematics_mirror.hpp): a second pass over the store would re-read it.
-void VelocityVerlet::kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const {
+void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror, bool four_at_a_time) {
   const auto drift = mirror ? drift_particles<true> : drift_particles<false>;
-  drift(p.n_owned(), 0.5 * dt_, dt_, p.pos.data(), p.vel.data(), p.acc.data(), p.theta.data(),
+  drift(p.n_owned(), 0.5 * dt, dt, p.pos.data(), p.vel.data(), p.acc.data(), p.theta.data(),
         p.omega.data(), p.alpha.data(), p.force.data(), p.torque.data(), p.radius.data(),
-        p.mass.data(), p.material.data(), mirror);
+        p.mass.data(), p.material.data(), mirror, four_at_a_time);
+}
+
+void VelocityVerlet::kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const {
+  dem2d::kick_drift_owned(p, dt_, mirror, true);
 }
 
 // The closing half kick fused with the accelerations, and the two maxima of the next step's

@@ -164,6 +164,13 @@ struct Drifted {
   return {x + dt * v_half, v_half, w + h * alpha};
 }
 
+// Velocity Verlet's opening half kick and drift of the owned particles of `p`, force and torque
+// cleared, and with `mirror` (not null) their pair-gather lines (core/kinematics_mirror.hpp).
+// With AVX-512 and `four_at_a_time`, four particles per iteration: the same operations in the
+// same order, so the same bits (test_core VelocityVerletDrift compares the two).
+void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror,
+                      bool four_at_a_time = true);
+
 // Velocity Verlet (kick-drift-kick); the velocity-dependent forces see the half-step velocity.
 class VelocityVerlet final : public Integrator {
  public:
