@@ -55,12 +55,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/vec2.hpp"
 #include "parallel/sector_partition.hpp"
+#include "settled_drum.hpp"
 
 namespace {
 
@@ -68,10 +69,11 @@ using dem2d::SectorPartition;
 using dem2d::Vec2;
 using Clock = std::chrono::steady_clock;
 
-constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m (bench/settled_drum.hpp)
+using bench::kRadiusMax;
+using bench::kRadiusMin;
+using bench::kRefDrum;
 constexpr double kSkin = 0.4 * kRadiusMin;
 constexpr double kHalo = 2.0 * kRadiusMax + kSkin;
-constexpr double kRefDrum = 2.5;
 constexpr double kTarget = 1.05;
 constexpr double kHaloLimit = 0.5;  // "the halo passes half the owned particles"
 const std::vector<int> kRanks{2, 4, 8, 16, 32, 64, 128, 256};
@@ -90,160 +92,32 @@ struct Charge {
   std::size_t size() const { return x.size(); }
 };
 
-// Uniform cell grid over the charge's bounding box (counting sort).
-class CellGrid {
- public:
-  CellGrid(const std::vector<Vec2>& x, double cell) : cell_(cell) {
-    lo_ = {1e300, 1e300};
-    Vec2 hi{-1e300, -1e300};
-    for (Vec2 p : x) {
-      lo_ = {std::min(lo_.x, p.x), std::min(lo_.y, p.y)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y)};
-    }
-    nx_ = static_cast<int>((hi.x - lo_.x) / cell_) + 1;
-    ny_ = static_cast<int>((hi.y - lo_.y) / cell_) + 1;
-    start_.assign(static_cast<std::size_t>(nx_) * ny_ + 1, 0);
-    for (Vec2 p : x) ++start_[index(p) + 1];
-    for (std::size_t c = 1; c < start_.size(); ++c) start_[c] += start_[c - 1];
-    items_.resize(x.size());
-    std::vector<int> fill(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < x.size(); ++i)
-      items_[static_cast<std::size_t>(fill[index(x[i])]++)] = static_cast<int>(i);
-  }
-  // Calls f(j) for every item in the 3x3 cells around p.
-  template <class F>
-  void neighbours(Vec2 p, F&& f) const {
-    const int cx = cx_of(p), cy = cy_of(p);
-    for (int y = std::max(0, cy - 1); y <= std::min(ny_ - 1, cy + 1); ++y)
-      for (int x = std::max(0, cx - 1); x <= std::min(nx_ - 1, cx + 1); ++x) {
-        const std::size_t c = static_cast<std::size_t>(y) * nx_ + x;
-        for (int k = start_[c]; k < start_[c + 1]; ++k) f(items_[static_cast<std::size_t>(k)]);
-      }
-  }
-
- private:
-  int cx_of(Vec2 p) const {
-    return std::clamp(static_cast<int>((p.x - lo_.x) / cell_), 0, nx_ - 1);
-  }
-  int cy_of(Vec2 p) const {
-    return std::clamp(static_cast<int>((p.y - lo_.y) / cell_), 0, ny_ - 1);
-  }
-  std::size_t index(Vec2 p) const { return static_cast<std::size_t>(cy_of(p)) * nx_ + cx_of(p); }
-  double cell_;
-  Vec2 lo_;
-  int nx_ = 1, ny_ = 1;
-  std::vector<int> start_, items_;
-};
-
-bool load_settled(const std::string& path, Charge& c) {
-  std::ifstream in(path);
-  if (!in) return false;
-  std::string line;
-  std::getline(in, line);
-  if (line.rfind("# settled_drum", 0) != 0) {
-    std::fprintf(stderr, "partition: %s: first line is not a '# settled_drum' comment\n",
-                 path.c_str());
-    std::exit(1);
-  }
-  std::getline(in, line);  // x,y,radius,vx,vy,spin
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    std::stringstream row(line);
-    std::string f;
-    double v[3];
-    for (double& value : v) {
-      std::getline(row, f, ',');
-      value = std::stod(f);
-    }
-    c.x.push_back({v[0], v[1]});
-    c.r.push_back(v[2]);
-  }
-  return true;
-}
-
-double percentile_y(const Charge& c, double q) {
-  std::vector<double> y;
-  y.reserve(c.size());
-  for (Vec2 p : c.x) y.push_back(p.y);
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(y.size() - 1));
-  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
-  return y[k];
-}
-
 // Charges (b) and (c): tiles of a patch of charge (a) (header).
 Charge tile_charge(const Charge& a, std::int64_t n_target, const std::string& name) {
   const double R = a.drum_radius, scale = std::sqrt(static_cast<double>(n_target) / a.size());
-  const double surface = percentile_y(a, 0.99);
-  const double half = 0.64 * R;
-  const double y0 = -std::sqrt(R * R - half * half) + 0.02 * R, y1 = surface - 0.05 * R;
-  const double w = 2.0 * half, h = y1 - y0;
-  std::vector<std::size_t> patch;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (std::abs(a.x[i].x) < half && a.x[i].y >= y0 && a.x[i].y < y1) patch.push_back(i);
-
   Charge b;
   b.name = name;
   b.drum_radius = R * scale;
-  const double Rb = b.drum_radius;
-  const double top = surface * scale + 0.1 * Rb;  // generous: trimmed to n_target below
-  const int cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
-  const int rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
-  std::vector<Vec2> cand;
-  std::vector<double> cand_r;
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < cols; ++i)
-      for (std::size_t k : patch) {
-        const Vec2 p{a.x[k].x + half - Rb + i * w, a.x[k].y - y0 - Rb + j * h};
-        if (p.y > top || norm(p) + a.r[k] > Rb) continue;
-        cand.push_back(p);
-        cand_r.push_back(a.r[k]);
-      }
-  // Keep-first overlap removal at the seams.
-  const CellGrid grid(cand, 2.0 * kRadiusMax);
-  std::vector<char> kept(cand.size(), 0);
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < cand.size(); ++i) {
-    bool clash = false;
-    grid.neighbours(cand[i], [&](int j) {
-      const auto u = static_cast<std::size_t>(j);
-      if (!clash && kept[u] && norm(cand[i] - cand[u]) < cand_r[i] + cand_r[u] - 1.0e-4)
-        clash = true;
-    });
-    if (!clash) {
-      kept[i] = 1;
-      order.push_back(i);
-    }
-  }
-  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
-    return cand[p].y != cand[q].y ? cand[p].y < cand[q].y : cand[p].x < cand[q].x;
-  });
-  if (static_cast<std::int64_t>(order.size()) < n_target) {
-    std::fprintf(stderr, "partition: tiling gave only %zu particles\n", order.size());
-    std::exit(1);
-  }
-  order.resize(static_cast<std::size_t>(n_target));
-  for (std::size_t i : order) {
-    b.x.push_back(cand[i]);
-    b.r.push_back(cand_r[i]);
-  }
+  // Seams may overlap by 0.1 mm: no dynamics here, only where the particles are.
+  bench::Tiling t = bench::tile(a.x, a.r, R, b.drum_radius, n_target, 1.0e-4);
+  b.x = std::move(t.pos);
+  b.r = std::move(t.radius);
   std::printf(
       "%s tiled in a drum of radius %.3f m: patch |x| < %.3f m, y in [%.3f, %.3f) m (%zu "
       "particles, of %zu), %d x %d copies, %zu candidates, %zu after the seam overlaps; surface "
       "y = %.3f m (%.3f x the 30k surface %.3f m = %.3f m)\n",
-      name.c_str(), Rb, half, y0, y1, patch.size(), a.size(), cols, rows, cand.size(),
-      static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), b.x.back().y, scale,
-      surface, surface * scale);
+      name.c_str(), b.drum_radius, t.half, t.y0, t.y1, t.patch, a.size(), t.cols, t.rows,
+      t.candidates, t.kept, b.x.back().y, scale, t.surface, t.surface * scale);
   return b;
 }
 
 // Contacts per particle: pairs with |x_i - x_j| < r_i + r_j + skin.
 std::vector<int> contacts_per_particle(const Charge& c, std::int64_t& pairs) {
-  const CellGrid grid(c.x, 2.0 * kRadiusMax + kSkin);
+  const bench::PointGrid grid(c.x, 2.0 * kRadiusMax + kSkin);
   std::vector<int> count(c.size(), 0);
   pairs = 0;
   for (std::size_t i = 0; i < c.size(); ++i)
-    grid.neighbours(c.x[i], [&](int j) {
-      const auto u = static_cast<std::size_t>(j);
+    grid.neighbours(c.x[i], [&](std::size_t u) {
       if (u <= i) return;
       if (norm(c.x[i] - c.x[u]) < c.r[i] + c.r[u] + kSkin) {
         ++count[i];
@@ -482,13 +356,17 @@ int main(int argc, char** argv) {
   Charge small;
   small.name = "30k";
   small.drum_radius = kRefDrum;
-  if (!load_settled(cache, small)) {
+  const std::optional<bench::Packing> settled =
+      bench::cached_packing(30000, opt.results + "/cache");
+  if (!settled) {
     std::fprintf(stderr,
                  "partition: %s is missing: make it with\n  build/bench/throughput --particles "
-                 "30000\n(settles the 30 000-sphere charge, ~1 min, and caches it)\n",
+                 "30000\n(settles the 30 000-sphere charge, ~6 min, and caches it)\n",
                  cache.c_str());
     return 1;
   }
+  small.x = settled->pos;
+  small.r = settled->radius;
   std::printf(
       "== partition: angular sectors, METIS (+refinement) vs equal angles; halo width "
       "h = 2 r_max + skin = %.1f mm\n",

@@ -103,7 +103,8 @@ namespace bench {
 
 constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m
 constexpr double kRefN = 30000.0, kRefDrum = 2.5, kRefSpeed = 1.5;
-constexpr const char* kCacheVersion = "settled_drum v7";  // bump when the recipe changes
+constexpr const char* kCacheVersion = "settled_drum v7";             // bump when the recipe changes
+constexpr const char* kTiledCacheVersion = "settled_drum tiled v8";  // N >= kTileFrom
 constexpr const char* kRatioCacheVersion = "settled_drum ratio v1";
 constexpr std::int64_t kTileFrom = 300000;  // N >= this: tiled from the kTileBase packing
 constexpr std::int64_t kTileBase = 30000;
@@ -325,6 +326,9 @@ inline void load_in_steel(Packing& out, double dt, int max_chunks = 20) {
   for (int chunk = 0; chunk < max_chunks; ++chunk) {
     for (int k = 0; k < 1000; ++k) steel_sim.step();
     const double c = static_cast<double>(steel_sim.last_totals().contacts);
+    std::fprintf(stderr, "   stage 3: %lld steps, %.3g contacts per particle\n",
+                 static_cast<long long>(steel_sim.step_count()),
+                 c / static_cast<double>(out.pos.size()));
     const bool flat = c < 1.01 * contacts;
     contacts = c;
     if (chunk >= 2 && flat) break;
@@ -348,6 +352,11 @@ inline Packing settle_scene(dem2d::Scene s, double radius, double load_dt) {
   while (true) {
     sim.run_until(sim.time() + 0.05);
     const double v = std::sqrt(2.0 * sim.diagnostics().kinetic_energy / mass);
+    std::fprintf(stderr,
+                 "   stage 1: t = %.2f s, mean speed %.4f m/s, %.3g contacts per particle\n",
+                 sim.time(), v,
+                 static_cast<double>(sim.last_totals().contacts) /
+                     static_cast<double>(sim.particles().n_owned()));
     if ((sim.time() >= 0.4 && v < 0.02) || sim.time() >= 1.0) break;
   }
   out.settle_time = sim.time();
@@ -355,6 +364,15 @@ inline Packing settle_scene(dem2d::Scene s, double radius, double load_dt) {
   remove_overlaps(sim, out, radius);
   load_in_steel(out, load_dt);
   out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+// Stages 1-3 from a tiled packing (header: N >= 300 000): the soft copy starts from the tiled
+// positions at rest; the seams' voids close and the bed takes the overlaps of its own depth.
+inline Packing settle_tiled(const Packing& tiled, std::int64_t n) {
+  const dem2d::Scene s = packing_scene(tiled, settling_material(soft_factor_for(n)), 0.0, 1.0e-6);
+  Packing out = settle_scene(s, drum_radius_for(n), 1.0e-6);
+  out.drum_radius = 0.0;  // drum_radius_for(n)
   return out;
 }
 
@@ -471,34 +489,42 @@ inline double largest_overlap(const std::vector<dem2d::Vec2>& x, const std::vect
   return worst;
 }
 
-// The tiled charge of n_target particles (header: N >= 300 000) from the settled packing `a`
-// (drum radius drum_radius_of(a)); velocities and spins zero, not yet loaded in steel.
-inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
-  const double R = drum_radius_of(a);
-  const double Rb = drum_radius_for(n_target);
-  const double scale = Rb / R;
-  const double surface = percentile_y(a.pos, 0.99);
-  const double half = 0.64 * R;
-  const double y0 = -std::sqrt(R * R - half * half) + 0.02 * R, y1 = surface - 0.05 * R;
-  const double w = 2.0 * half, h = y1 - y0;
+// The tiling of the large charges (header; bench/throughput and bench/partition): copies of a
+// rectangular patch of a settled packing (positions x, radii r, drum radius R) cover a drum of
+// radius Rb; a copy's particle is kept if it lies inside the drum and overlaps no particle kept
+// before it by more than `allowed`; the n_target lowest kept (by y, then x) are the charge.
+struct Tiling {
+  std::vector<dem2d::Vec2> pos;
+  std::vector<double> radius;
+  double half = 0.0, y0 = 0.0, y1 = 0.0, surface = 0.0;  // the patch; the source's 99th pct. y
+  std::size_t patch = 0, candidates = 0, kept = 0;
+  int cols = 0, rows = 0;
+};
+inline Tiling tile(const std::vector<dem2d::Vec2>& x, const std::vector<double>& r, double R,
+                   double Rb, std::int64_t n_target, double allowed) {
+  Tiling t;
+  t.surface = percentile_y(x, 0.99);
+  t.half = 0.64 * R;
+  t.y0 = -std::sqrt(R * R - t.half * t.half) + 0.02 * R;
+  t.y1 = t.surface - 0.05 * R;
+  const double w = 2.0 * t.half, h = t.y1 - t.y0;
   std::vector<std::size_t> patch;
-  for (std::size_t i = 0; i < a.pos.size(); ++i)
-    if (std::abs(a.pos[i].x) < half && a.pos[i].y >= y0 && a.pos[i].y < y1) patch.push_back(i);
-  const double top = surface * scale + 0.1 * Rb;  // generous: trimmed to n_target below
-  const int cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
-  const int rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (std::abs(x[i].x) < t.half && x[i].y >= t.y0 && x[i].y < t.y1) patch.push_back(i);
+  const double top = t.surface * (Rb / R) + 0.1 * Rb;  // generous: trimmed to n_target below
+  t.cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
+  t.rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
   std::vector<dem2d::Vec2> cand;
   std::vector<double> cand_r;
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < cols; ++i)
+  for (int j = 0; j < t.rows; ++j)
+    for (int i = 0; i < t.cols; ++i)
       for (std::size_t k : patch) {
-        const dem2d::Vec2 p{a.pos[k].x + half - Rb + i * w, a.pos[k].y - y0 - Rb + j * h};
-        if (p.y > top || dem2d::norm(p) + a.radius[k] > Rb) continue;
+        const dem2d::Vec2 p{x[k].x + t.half - Rb + i * w, x[k].y - t.y0 - Rb + j * h};
+        if (p.y > top || dem2d::norm(p) + r[k] > Rb) continue;
         cand.push_back(p);
-        cand_r.push_back(a.radius[k]);
+        cand_r.push_back(r[k]);
       }
-  // Keep-first at the seams: no overlap above the source packing's own largest.
-  const double allowed = std::max(largest_overlap(a.pos, a.radius), 1e-9);
+  // Keep-first at the seams.
   const PointGrid grid(cand, 2.0 * kRadiusMax);
   std::vector<char> kept(cand.size(), 0);
   std::vector<std::size_t> order;
@@ -519,12 +545,25 @@ inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
   if (static_cast<std::int64_t>(order.size()) < n_target)
     throw std::runtime_error("settled_drum: tiling gave only " + std::to_string(order.size()) +
                              " particles");
+  t.patch = patch.size();
+  t.candidates = cand.size();
+  t.kept = order.size();
   order.resize(static_cast<std::size_t>(n_target));
-  Packing b;
   for (std::size_t i : order) {
-    b.pos.push_back(cand[i]);
-    b.radius.push_back(cand_r[i]);
+    t.pos.push_back(cand[i]);
+    t.radius.push_back(cand_r[i]);
   }
+  return t;
+}
+
+// The tiled charge of n_target particles (header: N >= 300 000) from the settled packing `a`,
+// seams allowed no overlap above a's own largest; velocities and spins zero, not yet loaded.
+inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
+  const double allowed = std::max(largest_overlap(a.pos, a.radius), 1e-9);
+  Tiling t = tile(a.pos, a.radius, drum_radius_of(a), drum_radius_for(n_target), n_target, allowed);
+  Packing b;
+  b.pos = std::move(t.pos);
+  b.radius = std::move(t.radius);
   fill_order(b.pos, b.radius);
   b.vel.assign(b.pos.size(), dem2d::Vec2{});
   b.spin.assign(b.pos.size(), 0.0);
@@ -533,9 +572,8 @@ inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
                 "tiled from the settled %zu packing: patch |x| < %.4g m, y in [%.4g, %.4g) m (%zu "
                 "particles), %d x %d copies, %zu candidates, %zu kept (seam overlaps <= %.3g m), "
                 "the %lld lowest",
-                a.pos.size(), half, y0, y1, patch.size(), cols, rows, cand.size(),
-                static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)), allowed,
-                static_cast<long long>(n_target));
+                a.pos.size(), t.half, t.y0, t.y1, t.patch, t.cols, t.rows, t.candidates, t.kept,
+                allowed, static_cast<long long>(n_target));
   b.recipe = buf;
   return b;
 }
@@ -671,7 +709,8 @@ inline std::string drum_cache_path(std::int64_t n, const std::string& cache_dir)
 
 // The drum packing of N particles if DIR/settled_drum_<N>.csv holds it (never settles).
 inline std::optional<Packing> cached_packing(std::int64_t n, const std::string& cache_dir) {
-  return read_packing(drum_cache_path(n, cache_dir), kCacheVersion, n);
+  return read_packing(drum_cache_path(n, cache_dir),
+                      n >= kTileFrom ? kTiledCacheVersion : kCacheVersion, n);
 }
 
 inline std::string settle_note(const Packing& out) {
@@ -694,17 +733,16 @@ inline Packing settled_packing(std::int64_t n, const std::string& cache_dir, boo
   }
   Packing out;
   std::ostringstream head;
-  head << kCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; ";
+  head << (n >= kTileFrom ? kTiledCacheVersion : kCacheVersion) << ": N = " << n << ", drum radius "
+       << drum_radius_for(n) << " m; ";
   if (n >= kTileFrom) {
     const Packing base = settled_packing(kTileBase, cache_dir, verbose);
     const auto t0 = std::chrono::steady_clock::now();
-    out = tile_packing(base, n);
-    out.drum_radius = 0.0;
-    load_in_steel(out, 1.0e-6, 10);
+    const Packing tiled = tile_packing(base, n);
+    out = settle_tiled(tiled, n);
     out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    head << out.recipe << "; loaded in steel for " << out.load_steps << " steps ("
-         << out.contacts_per_particle << " contacts per particle); " << out.settle_wall
-         << " s of wall time";
+    head << tiled.recipe << "; then settled soft (E x " << soft_factor_for(n) << ") for "
+         << out.settle_time << " s, " << settle_note(out);
   } else {
     out = settle_packing(n);
     head << "settled soft (E x " << soft_factor_for(n) << ") for " << out.settle_time << " s, "
