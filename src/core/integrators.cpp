@@ -74,9 +74,6 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
 
 namespace {
 
-// The opening half kick and drift of particles [0, n), and with kMirror their pair-gather mirror
-// lines, read back from the store just written (pointers as arguments: captured by a lambda they
-// ran out of registers).
 #if DEM2D_VECTOR_GATHER
 // Particles [0, 4 floor(n / 4)) of drift_particles, four at a time: the same multiplications and
 // additions in the same order (no FMA contraction), so the same bits; returns where it stopped.
@@ -129,6 +126,9 @@ std::size_t drift_fours(std::size_t n, double h, double dt, Vec2* x, Vec2* v, co
 }
 #endif
 
+// The opening half kick and drift of particles [0, n), and with kMirror their pair-gather mirror
+// lines, read back from the store just written (pointers as arguments: captured by a lambda they
+// ran out of registers); with `fours`, drift_fours takes the whole fours.
 template <bool kMirror>
 void drift_particles(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const Vec2* a,
                      double* th, double* w, const double* al, Vec2* f, double* tq,
