@@ -10,9 +10,10 @@
 # both binaries. RANKS (default 1) is the rank count of both runs; the new binary at another
 # rank count must agree too (the decomposition is bit-identical at any rank count). Prints one
 # line per deck and exits 1 when any deck's snapshots differ; a series.csv that differs is
-# reported with its largest difference (the column, relative to the column's largest value). NEW_ARGS (environment) is added to the new
-# binary's command line, e.g. NEW_ARGS="--set run.spatial_sort=always" to compare a store
-# sorted at every rebuild with the old binary's id order.
+# reported with its largest difference (the column, relative to the column's largest value).
+# NEW_ARGS (environment) is added to the new binary's command line, e.g.
+# NEW_ARGS="--set run.spatial_sort=always" to compare a store sorted at every rebuild with the
+# old binary's id order.
 set -u
 old=$1
 new=$2

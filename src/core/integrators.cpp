@@ -58,7 +58,7 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
     std::fill(p.elastic_force.data(), p.elastic_force.data() + p.n_owned(), Vec2{});
     elastic_cleared_ = true;
   }
-  kick_drift_owned(p, s.drift_mirror());  // v += a dt/2, x += v dt; accumulators cleared
+  kick_drift_owned(p, dt_, s.drift_mirror());  // v += a dt/2, x += v dt; accumulators cleared
   s.advance_clock();
   if (rebuild_next_)  // decided in the previous step's round
     s.rebuild();
@@ -100,27 +100,8 @@ std::size_t drift_fours(std::size_t n, double h, double dt, Vec2* x, Vec2* v, co
     _mm256_storeu_pd(th + k, _mm256_add_pd(_mm256_loadu_pd(th + k), _mm256_mul_pd(dt4, w_new)));
     _mm512_storeu_pd(&f[k].x, _mm512_setzero_pd());
     _mm256_storeu_pd(tq + k, _mm256_setzero_pd());
-    if constexpr (kMirror) {
-      // Lines (x, y, vx, vy | w, r, m, material): motion halves of particles 0|1 and 2|3, then
-      // the other halves, then each line from its two halves.
-      const __m512d motion01 =
-          _mm512_permutex2var_pd(x_new, _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), v_half);
-      const __m512d motion23 =
-          _mm512_permutex2var_pd(x_new, _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15), v_half);
-      const __m512d wr =
-          _mm512_insertf64x4(_mm512_castpd256_pd512(w_new), _mm256_loadu_pd(r + k), 1);
-      const __m512d mm = _mm512_insertf64x4(
-          _mm512_castpd256_pd512(_mm256_loadu_pd(m + k)),
-          _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(mat + k))), 1);
-      const __m512d body01 =
-          _mm512_permutex2var_pd(wr, _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13), mm);
-      const __m512d body23 =
-          _mm512_permutex2var_pd(wr, _mm512_setr_epi64(2, 6, 10, 14, 3, 7, 11, 15), mm);
-      _mm512_store_pd(&mirror[k].x, _mm512_shuffle_f64x2(motion01, body01, 0x44));
-      _mm512_store_pd(&mirror[k + 1].x, _mm512_shuffle_f64x2(motion01, body01, 0xEE));
-      _mm512_store_pd(&mirror[k + 2].x, _mm512_shuffle_f64x2(motion23, body23, 0x44));
-      _mm512_store_pd(&mirror[k + 3].x, _mm512_shuffle_f64x2(motion23, body23, 0xEE));
-    }
+    if constexpr (kMirror)
+      store_kinematics4(mirror + k, x_new, v_half, w_new, r + k, m + k, mat + k);
   }
   return k;
 }
@@ -162,10 +143,6 @@ void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror, bool 
   drift(p.n_owned(), 0.5 * dt, dt, p.pos.data(), p.vel.data(), p.acc.data(), p.theta.data(),
         p.omega.data(), p.alpha.data(), p.force.data(), p.torque.data(), p.radius.data(),
         p.mass.data(), p.material.data(), mirror, four_at_a_time);
-}
-
-void VelocityVerlet::kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const {
-  dem2d::kick_drift_owned(p, dt_, mirror, true);
 }
 
 // The closing half kick fused with the accelerations, and the two maxima of the next step's

@@ -190,7 +190,6 @@ class VelocityVerlet final : public Integrator {
     double motion2 = 0.0;              // max |v + a dt/2|^2 / r^2 (owned)
     double late_loss = 0.0;            // J, see closing_kick
   };
-  void kick_drift_owned(ParticleStore& p, PairKinematics* mirror) const;
   Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
   void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
   StepOutcome end_of_step_round(StepStages& s, const Closing& c);

@@ -46,6 +46,31 @@ struct alignas(64) PairKinematics {
   _mm256_store_pd(&out.x, motion);
   _mm256_store_pd(&out.w, _mm256_setr_pd(w, r, m, static_cast<double>(material)));
 }
+
+// Four consecutive particles' lines at once (Velocity Verlet's drift, four at a time): x and v
+// hold (x, y) of the four side by side, w their spins; r, m and material point at the first's.
+[[gnu::always_inline]] inline void store_kinematics4(PairKinematics* out, __m512d x, __m512d v,
+                                                     __m256d w, const double* r, const double* m,
+                                                     const std::int32_t* material) {
+  // Motion halves (x, y, vx, vy) of particles 0|1 and 2|3, body halves (w, r, m, material)
+  // likewise, then each line from its two halves.
+  const __m512d motion01 =
+      _mm512_permutex2var_pd(x, _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), v);
+  const __m512d motion23 =
+      _mm512_permutex2var_pd(x, _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15), v);
+  const __m512d wr = _mm512_insertf64x4(_mm512_castpd256_pd512(w), _mm256_loadu_pd(r), 1);
+  const __m512d mm = _mm512_insertf64x4(
+      _mm512_castpd256_pd512(_mm256_loadu_pd(m)),
+      _mm256_cvtepi32_pd(_mm_loadu_si128(reinterpret_cast<const __m128i*>(material))), 1);
+  const __m512d body01 =
+      _mm512_permutex2var_pd(wr, _mm512_setr_epi64(0, 4, 8, 12, 1, 5, 9, 13), mm);
+  const __m512d body23 =
+      _mm512_permutex2var_pd(wr, _mm512_setr_epi64(2, 6, 10, 14, 3, 7, 11, 15), mm);
+  _mm512_store_pd(&out[0].x, _mm512_shuffle_f64x2(motion01, body01, 0x44));
+  _mm512_store_pd(&out[1].x, _mm512_shuffle_f64x2(motion01, body01, 0xEE));
+  _mm512_store_pd(&out[2].x, _mm512_shuffle_f64x2(motion23, body23, 0x44));
+  _mm512_store_pd(&out[3].x, _mm512_shuffle_f64x2(motion23, body23, 0xEE));
+}
 #endif
 
 class KinematicsMirror {
