@@ -28,42 +28,28 @@
 //  3. Steel, at dt = 1e-6 s: gravity closes the gaps and loads the contacts (~5-10 ms). It runs
 //     in chunks of 1000 steps until the number of contacts grows by less than 1 % in a chunk
 //     (at least 3000, at most 20 000 steps).
-// N >= 300 000 (3e5, 1e6): settling by dynamics would take hours, so the packing is built
-// without dynamics by tiling the settled 30 000 packing (tile_packing: the construction of
-// tile_charge in bench/partition.cpp, with a stricter seam rule). A rectangular patch is cut
-// from the interior of the 30 000 charge (|x| < 0.64 R, from 0.02 R above the shell at
-// x = 0.64 R up to 0.05 R below the bed surface, the 99th percentile of y: about half the
-// charge); copies of it, side by side with the patch's width and height as periods, cover the
-// big drum (radius R(N) as above); a copy's particle is kept if it lies inside the drum and
-// overlaps no particle kept before it by more than the largest overlap in the settled 30 000
-// packing itself (micrometres; partition.cpp allows 0.1 mm, which in steel would fire the
-// particles apart at metres per second), so the seams leave small gaps. The N lowest kept
-// particles (by y) are the charge, at rest; ids are given in the fill's order (fill_order: rows
-// of the fill's lattice pitch 2.1 r_max sqrt(3)/2 from the bottom up, a fixed pseudo-random
-// order within a row). Then stage 3 (steel, drum still, at least 3000, at most 10 000 steps).
-// Measured (1e6, 2026-11-26): stage 3 stopped after its 3000 steps with 0.50 contacts per
-// particle (the 30 000 source: 1.54; candidate pairs within 2.4 mm: 2.38 per particle in both).
-// The copied overlaps are those of the source's depth (1.4 m at most), not of the 10 m deep
-// bed, so they spring apart and the bed rattles at ~3 cm/s with micrometre gaps; loading it
-// under its own weight would take tens of ms (a compression wave over 10 m of spheres,
-// several passes: 3e4-5e4 steps of 1e6 particles, about an hour of CPU), which was not done.
-// So the tiled sizes have the candidate pairs of a settled bed but a third of its contacts.
-// Two cheaper loadings were tried (2026-11-26, third session) and dropped:
-//  - stage 3 in steel with e = 0.1: 1.39 contacts per particle after 1000 steps, then 0.93,
-//    0.56, 0.28, 0.13 after 2000-5000 steps while the mean speed grew by about 1 cm/s per ms
-//    (free fall at ~g): the copies meet along ragged edges with voids between them, and the
-//    layers above each seam fall into them. Closing them by falling takes ~0.1 s (1e5 steps).
-//  - lowering each particle straight down, from the lowest up, onto the particles below it
-//    before stage 3 (no voids, contacts at zero overlap): 0.76, 0.51, 0.36, 0.33 contacts per
-//    particle after 1000-4000 steps, the mean speed again growing ~1 cm/s per ms: most
-//    particles then rest on one sphere instead of in a pocket, and with mu_s = 0.1 they roll off
-//    it. A gap-free tiling would need each particle rolled into a pocket of two supports.
-//  - (fourth session) stages 1-3 of the smaller sizes from the tiled positions (soft copy,
-//    E x 0.0316, at rest): after 0.05, 0.10, ..., 0.30 s of simulated time the mean speed was
-//    0.47, 0.84, 0.99, 0.76, 0.29, 0.33 m/s and the contacts per particle 0.31, 0.69, 1.17,
-//    1.66, 1.80, 1.80 (6-8 min of one core per 0.05 s). The seams' voids closed within 0.25 s,
-//    but the soft bed still moved at 0.3 m/s, so stage 1 would have run to its 1 s limit
-//    (2-2.5 hours) before the overlap removal and the loading: stopped there, not done.
+// N >= 300 000 (3e5, 1e6): settling by dynamics would take hours (a 1e6 soft settle was stopped
+// after 40 minutes of one core at 0.3 s of its at least 0.4 s, 2026-11-26), so
+// the bed is deposited and loaded (deposit_packing, deposited_packing; bench/throughput's
+// "deposited" section builds the smaller sizes the same way, to compare like with like):
+//  1. Deposition (bench/deposition.hpp): N discs, radii uniform in [6, 10] mm, dropped one by
+//     one into the drum of radius R(N) and rolled, frictionless and quasi-static, into a pocket
+//     of two supports (discs or the wall), touching them at zero overlap; of 4 pseudo-random drop
+//     points per disc the lowest landing is taken, so that the bed grows in flat layers. Ids in
+//     the fill's order (fill_order). 2 s for 1e6 discs; 1.99 touching pairs per disc; largest
+//     overlap 3e-12 m (rounding).
+//  2. Loading, drum still, at dt = 1e-6 s in deposited_material() (steel with e = 0.1 and
+//     mu_s = 0.5), in chunks of 1000 steps until the contacts grow by less than 1 % in a chunk
+//     (at least 3, at most 60 chunks): 30 000 spheres reach 1.89 contacts per particle in 9 000
+//     steps, 1e5 in 14 000.
+// The thesis steel (e = 0.73, mu_s = 0.1) cannot hold a deposited bed: its loose layers keep
+// closing up (30 000: 1.89 contacts per particle after loading, 1.47 after 1 000 more steps, 0.19
+// after 4 500 steps in the turning drum), so deposited beds are measured in deposited_material()
+// (settled_scene), which costs the same per contact: the law is the same code, only two
+// coefficients differ. Before this (until 2026-11-26) the large sizes were tiled from copies of a
+// patch of the settled 30 000 packing (bench::tile, still used by bench/partition, which needs
+// positions only); the seams between copies left voids, and loading that bed was tried three
+// ways without success (only 0.5 contacts per particle at 1e6; the soft settle above).
 //
 // The size-ratio charges (settle_ratio_packing, bench/throughput's "ratios" section): N spheres
 // of the same steel with radii log-uniform between r_max / ratio and r_max = 10 mm (the
@@ -94,6 +80,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <sstream>
@@ -104,6 +91,7 @@
 
 #include "core/scene.hpp"
 #include "core/simulation.hpp"
+#include "deposition.hpp"
 
 namespace bench {
 
@@ -111,10 +99,11 @@ constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m
 constexpr double kRefN = 30000.0, kRefDrum = 2.5, kRefSpeed = 1.5;
 constexpr const char* kCacheVersion = "settled_drum v7";  // bump when the recipe changes
 constexpr const char* kRatioCacheVersion = "settled_drum ratio v1";
-constexpr std::int64_t kTileFrom = 300000;  // N >= this: tiled from the kTileBase packing
-constexpr std::int64_t kTileBase = 30000;
-constexpr double kFillFraction = 0.31;  // charge area / drum area
-constexpr double kRatioDt = 5.0e-7;     // s: every size-ratio run (1 mm steel spheres)
+constexpr const char* kDepositCacheVersion = "deposited_drum v1";
+constexpr std::int64_t kDepositFrom = 300000;  // settled_packing: N >= this deposited
+constexpr int kDepositLoadChunks = 60;         // of 1000 steps, at most
+constexpr double kFillFraction = 0.31;         // charge area / drum area
+constexpr double kRatioDt = 5.0e-7;            // s: every size-ratio run (1 mm steel spheres)
 
 inline double drum_radius_for(std::int64_t n) {
   return kRefDrum * std::sqrt(static_cast<double>(n) / kRefN);
@@ -175,6 +164,8 @@ struct Packing {
   int relax_rounds = 0;                // candidate-pair rebuilds of stage 2
   std::int64_t load_steps = 0;         // steps of stage 3
   double contacts_per_particle = 0.0;  // at the end of stage 3
+  double mean_speed = 0.0;             // m/s, sqrt(2 KE / M) at the end of stage 3
+  bool deposited = false;              // deposit_packing: measured in deposited_material()
   double drum_radius = 0.0;            // m; 0: drum_radius_for(N)
   std::string recipe;                  // how it was made (the cache file's first line)
 };
@@ -228,6 +219,19 @@ inline bool relax_overlaps(std::vector<dem2d::Vec2>& x, const std::vector<double
   return false;
 }
 
+// The material of a deposited bed (deposit_packing), loaded and measured in it: steel, well
+// damped (e = 0.1) and with friction 0.5. It holds the bed: in the thesis steel (e = 0.73,
+// mu_s = 0.1) a deposited bed does not stay put, it keeps compacting (30 000 spheres: 1.89
+// contacts per particle after loading, 1.47 after 1000 more steps in the thesis steel with the
+// drum still and 0.19 after the throughput run's 4 500 steps with it turning, the particles
+// falling as the loose layers of the deposition close up).
+inline dem2d::MaterialSpec deposited_material() {
+  dem2d::MaterialSpec m = steel(1.0);
+  m.restitution = 0.1;
+  m.sliding_friction = 0.5;
+  return m;
+}
+
 // A scene of the packing's particles (with their velocities) in `material`, dt given.
 inline dem2d::Scene packing_scene(const Packing& pk, const dem2d::MaterialSpec& material,
                                   double drum_speed, double dt) {
@@ -247,10 +251,12 @@ inline dem2d::Scene packing_scene(const Packing& pk, const dem2d::MaterialSpec& 
   return s;
 }
 
-// The measured scene: steel, the drum turning at its full speed from t = 0.
+// The measured scene: steel (a deposited bed: deposited_material()), the drum turning at its full
+// speed from t = 0.
 inline dem2d::Scene settled_scene(const Packing& pk, double dt) {
   const double radius = drum_radius_of(pk);
-  return packing_scene(pk, steel(1.0), drum_speed_for(radius), dt);
+  return packing_scene(pk, pk.deposited ? deposited_material() : steel(1.0), drum_speed_for(radius),
+                       dt);
 }
 
 // Copy the state of a simulation back into the packing (ids follow the particle list).
@@ -325,15 +331,21 @@ inline void remove_overlaps(dem2d::Simulation& sim, Packing& out, double radius)
 
 // Stage 3: steel at `dt` with the drum still, in chunks of 1000 steps until the contacts grow by
 // less than 1 % in a chunk (at least 3 chunks, at most `max_chunks`).
-inline void load_in_steel(Packing& out, double dt, int max_chunks = 20) {
-  dem2d::Simulation steel_sim(packing_scene(out, steel(1.0), 0.0, dt));
+inline void load_in_steel(Packing& out, double dt, int max_chunks = 20,
+                          const dem2d::MaterialSpec& material = steel(1.0)) {
+  dem2d::Simulation steel_sim(packing_scene(out, material, 0.0, dt));
+  double mass = 0.0;
+  for (std::size_t k = 0; k < steel_sim.particles().n_owned(); ++k)
+    mass += steel_sim.particles().mass[k];
   double contacts = 0.0;
   for (int chunk = 0; chunk < max_chunks; ++chunk) {
     for (int k = 0; k < 1000; ++k) steel_sim.step();
     const double c = static_cast<double>(steel_sim.last_totals().contacts);
-    std::fprintf(stderr, "   stage 3: %lld steps, %.3g contacts per particle\n",
+    out.mean_speed = std::sqrt(2.0 * steel_sim.diagnostics().kinetic_energy / mass);
+    std::fprintf(stderr,
+                 "   stage 3: %lld steps, %.3g contacts per particle, mean speed %.3g m/s\n",
                  static_cast<long long>(steel_sim.step_count()),
-                 c / static_cast<double>(out.pos.size()));
+                 c / static_cast<double>(out.pos.size()), out.mean_speed);
     const bool flat = c < 1.01 * contacts;
     contacts = c;
     if (chunk >= 2 && flat) break;
@@ -485,7 +497,7 @@ inline double largest_overlap(const std::vector<dem2d::Vec2>& x, const std::vect
   return worst;
 }
 
-// The tiling of the large charges (header; bench/throughput and bench/partition): copies of a
+// The tiling of bench/partition's large charges (until 2026-11-26 also the drum's): copies of a
 // rectangular patch of a settled packing (positions x, radii r, drum radius R) cover a drum of
 // radius Rb; a copy's particle is kept if it lies inside the drum and overlaps no particle kept
 // before it by more than `allowed`; the n_target lowest kept (by y, then x) are the charge.
@@ -552,24 +564,46 @@ inline Tiling tile(const std::vector<dem2d::Vec2>& x, const std::vector<double>&
   return t;
 }
 
-// The tiled charge of n_target particles (header: N >= 300 000) from the settled packing `a`,
-// seams allowed no overlap above a's own largest; velocities and spins zero, not yet loaded.
-inline Packing tile_packing(const Packing& a, std::int64_t n_target) {
-  const double allowed = std::max(largest_overlap(a.pos, a.radius), 1e-9);
-  Tiling t = tile(a.pos, a.radius, drum_radius_of(a), drum_radius_for(n_target), n_target, allowed);
+// The deposited charge of n particles (header: N >= 300 000): radii uniform in
+// [kRadiusMin, kRadiusMax] and drop points from a fixed pseudo-random sequence; of `choices`
+// drop points for each disc the one where it would first land lowest is taken, so that the bed
+// grows in flat layers (dropped at uniformly random x, the shallow sides of a circular drum fill
+// first and the bed turns into a V). Velocities and spins zero, not yet loaded.
+inline Packing deposit_packing(std::int64_t n, int choices = 4) {
+  const double R = drum_radius_for(n);
+  Deposition d(R, kRadiusMax);
+  std::uint64_t seq = 0;
+  auto uniform = [&] { return static_cast<double>(splitmix64(seq++) >> 11U) * 0x1p-53; };
+  std::int64_t rolls = 0;
+  for (std::int64_t k = 0; k < n; ++k) {
+    const double r = kRadiusMin + (kRadiusMax - kRadiusMin) * uniform();
+    double x = 0.0, low = std::numeric_limits<double>::infinity();
+    bool tie = false;
+    for (int c = 0; c < choices; ++c) {
+      const double u = uniform(), xc = (R - r) * (2.0 * u - 1.0);
+      const double y = d.landing(xc, r);
+      if (y < low) {
+        low = y;
+        x = xc;
+        tie = u < 0.5;
+      }
+    }
+    d.drop(x, r, tie);
+  }
+  rolls = d.rolls();
   Packing b;
-  b.pos = std::move(t.pos);
-  b.radius = std::move(t.radius);
+  b.pos = d.positions();
+  b.radius = d.radii();
   fill_order(b.pos, b.radius);
   b.vel.assign(b.pos.size(), dem2d::Vec2{});
   b.spin.assign(b.pos.size(), 0.0);
-  char buf[512];
+  b.deposited = true;
+  char buf[256];
   std::snprintf(buf, sizeof buf,
-                "tiled from the settled %zu packing: patch |x| < %.4g m, y in [%.4g, %.4g) m (%zu "
-                "particles), %d x %d copies, %zu candidates, %zu kept (seam overlaps <= %.3g m), "
-                "the %lld lowest",
-                a.pos.size(), t.half, t.y0, t.y1, t.patch, t.cols, t.rows, t.candidates, t.kept,
-                allowed, static_cast<long long>(n_target));
+                "deposited (frictionless quasi-static rolling into two-support pockets, lowest of "
+                "%d drop points per disc, %.3g rolls per disc; largest overlap %.3g m)",
+                choices, static_cast<double>(rolls) / static_cast<double>(n),
+                largest_overlap(b.pos, b.radius));
   b.recipe = buf;
   return b;
 }
@@ -703,9 +737,49 @@ inline std::string drum_cache_path(std::int64_t n, const std::string& cache_dir)
   return cache_dir + "/settled_drum_" + std::to_string(n) + ".csv";
 }
 
-// The drum packing of N particles if DIR/settled_drum_<N>.csv holds it (never settles).
+inline std::string deposited_cache_path(std::int64_t n, const std::string& cache_dir) {
+  return cache_dir + "/deposited_drum_" + std::to_string(n) + ".csv";
+}
+
+// The drum packing of N particles if the cache holds it (never settles): DIR/settled_drum_<N>.csv
+// below kDepositFrom, the deposited bed's file from there on (settled_packing).
 inline std::optional<Packing> cached_packing(std::int64_t n, const std::string& cache_dir) {
+  if (n >= kDepositFrom) {
+    std::optional<Packing> pk =
+        read_packing(deposited_cache_path(n, cache_dir), kDepositCacheVersion, n);
+    if (pk) pk->deposited = true;
+    return pk;
+  }
   return read_packing(drum_cache_path(n, cache_dir), kCacheVersion, n);
+}
+
+// The deposited drum packing of N particles (header), loaded: read from
+// DIR/deposited_drum_<N>.csv or made and written there.
+inline Packing deposited_packing(std::int64_t n, const std::string& cache_dir,
+                                 bool verbose = true) {
+  const std::string path = deposited_cache_path(n, cache_dir);
+  if (std::optional<Packing> pk = read_packing(path, kDepositCacheVersion, n)) {
+    pk->deposited = true;
+    return *pk;
+  }
+  if (verbose) {
+    std::printf("   depositing and loading %lld particles (cached afterwards in %s) ...\n",
+                static_cast<long long>(n), path.c_str());
+    std::fflush(stdout);
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  Packing out = deposit_packing(n);
+  load_in_steel(out, 1.0e-6, kDepositLoadChunks, deposited_material());
+  out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::ostringstream head;
+  head << kDepositCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; "
+       << out.recipe << "; loaded in steel with e = 0.1, mu_s = 0.5 for " << out.load_steps
+       << " steps (" << out.contacts_per_particle << " contacts per particle, mean speed "
+       << out.mean_speed << " m/s); " << out.settle_wall << " s of wall time";
+  out.recipe = head.str();
+  std::filesystem::create_directories(cache_dir);
+  write_packing(path, out.recipe, out);
+  return out;
 }
 
 inline std::string settle_note(const Packing& out) {
@@ -716,9 +790,10 @@ inline std::string settle_note(const Packing& out) {
   return f.str();
 }
 
-// The settled drum packing of N particles (header: tiled for N >= 300 000), read from
+// The settled drum packing of N particles (header: deposited for N >= 300 000), read from
 // DIR/settled_drum_<N>.csv or made and written there.
 inline Packing settled_packing(std::int64_t n, const std::string& cache_dir, bool verbose = true) {
+  if (n >= kDepositFrom) return deposited_packing(n, cache_dir, verbose);
   const std::string path = drum_cache_path(n, cache_dir);
   if (std::optional<Packing> pk = cached_packing(n, cache_dir)) return *pk;
   if (verbose) {
@@ -726,24 +801,11 @@ inline Packing settled_packing(std::int64_t n, const std::string& cache_dir, boo
                 static_cast<long long>(n), path.c_str());
     std::fflush(stdout);
   }
-  Packing out;
+  Packing out = settle_packing(n);
   std::ostringstream head;
-  head << kCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; ";
-  if (n >= kTileFrom) {
-    const Packing base = settled_packing(kTileBase, cache_dir, verbose);
-    const auto t0 = std::chrono::steady_clock::now();
-    out = tile_packing(base, n);
-    out.drum_radius = 0.0;
-    load_in_steel(out, 1.0e-6, 10);
-    out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    head << out.recipe << "; loaded in steel for " << out.load_steps << " steps ("
-         << out.contacts_per_particle << " contacts per particle); " << out.settle_wall
-         << " s of wall time";
-  } else {
-    out = settle_packing(n);
-    head << "settled soft (E x " << soft_factor_for(n) << ") for " << out.settle_time << " s, "
-         << settle_note(out);
-  }
+  head << kCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; "
+       << "settled soft (E x " << soft_factor_for(n) << ") for " << out.settle_time << " s, "
+       << settle_note(out);
   out.recipe = head.str();
   std::filesystem::create_directories(cache_dir);
   write_packing(path, out.recipe, out);

@@ -1,18 +1,26 @@
 // throughput: particle-steps per second of one core, how the cost scales with N and with the
 // size ratio, and what memory a particle takes (issue 13, "Fast at every size").
 //
-// Sections (--sections, default all four, in this order):
+// Sections (--sections, default all but order, in this order):
 // drum       The settled polydisperse steel drum (bench/settled_drum.hpp: r uniform in
 //            [6, 10] mm; thesis steel: E = 2e11 Pa, G = 8e10 Pa, rho = 7800, e = 0.73,
 //            mu_s = 0.1, mu_r = 0.05; hertz-mindlin + epsd; circular drum, sides = 0, fill
-//            fraction 0.31) for N = 1e3, 3e3, 1e4, 3e4, 1e5, 1e6 (--particles): drum radius
+//            fraction 0.31) for N = 1e3, 3e3, 1e4, 3e4, 1e5 (--particles): drum radius
 //            R = 2.5 m sqrt(N / 30 000), speed 1.5 rad/s sqrt(2.5 m / R) (Froude 0.57),
 //            dt = 1e-6 s. N = 3e4 is the issue-2 target scene (15 million particle-steps/s).
-//            N < 3e5 are settled by dynamics, N >= 3e5 tiled from the settled 3e4 packing and
-//            run 3000 steps in steel (settled_drum.hpp says exactly how; the tiled bed is not
-//            loaded like a settled one: 0.5 contacts per particle at 1e6, not 1.5). Steps per
-//            repeat: min(max(--steps, 3e7 / N), 3e8 / N): 30 000 at 1e3, 2 000 at 3e4 and 1e5, 1
-//            000 at 3e5, 300 at 1e6.
+//            N < 3e5 are settled by dynamics; N >= 3e5 given here are the deposited beds below.
+//            Steps per repeat: min(max(--steps, 3e7 / N), 3e8 / N): 30 000 at 1e3, 2 000 at
+//            3e4 and 1e5, 1 000 at 3e5, 300 at 1e6.
+// deposited  The same drums built by deposition and loaded (settled_drum.hpp, deposit_packing:
+//            no dynamics until the loading, so a million particles take minutes, not hours)
+//            for N = 1e4, 3e4, 1e5, 1e6 (--deposited): one recipe at every size, so the cost
+//            per particle-step is compared to the 1e4 bed of the same recipe (target of
+//            issue 13: within 1.3x up to 1e6). Measured in the material they are loaded in
+//            (steel with e = 0.1, mu_s = 0.5: the thesis steel cannot hold a deposited bed) and
+//            with the drum still (--deposited-speed F: F times the drum's full speed): started
+//            at full speed with this friction, the smaller beds dilate at the shell within the
+//            measured steps (1e4: 1.12 contacts per particle, 1e5: 1.78), which would measure
+//            the bed, not the code. Steps per repeat as for the drum.
 // ratios     Size ratio r_max / r_min = 1, 2, 5, 10 (--ratios) at the same count N = 20 000
 //            (--ratio-particles) and fill fraction 0.31: radii log-uniform in
 //            [10 mm / ratio, 10 mm] (ratio 1: all 10 mm), drum radius sqrt(sum r^2 / 0.31),
@@ -56,21 +64,23 @@
 // section, N, size ratio, ...) and DIR/throughput.png (post/plot_throughput.py through
 // std::system; --no-plot skips it).
 //
-//   throughput [--sections drum,ratios,block,waterfall,order] [--quick] [--particles N1,...]
-//              [--ratios R1,R2,...] [--ratio-particles N] [--steps S] [--repeats R]
+//   throughput [--sections drum,deposited,ratios,block,waterfall,order] [--quick]
+//              [--particles N1,...] [--deposited N1,...] [--deposited-speed F] [--ratios R1,R2,...]
+//              [--ratio-particles N]
+//              [--steps S] [--repeats R]
 //              [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot] [--no-cache]
 //              [--results DIR] [--csv NAME] [--order-particles N1,N2,...]
 //   throughput --profile-block STEPS      (bench/profile_contacts.sh)
 //   throughput --profile-drum N STEPS
 //
-// Without --sections all four run; --particles without --sections runs the drum section and the
-// waterfall only, as the program did before it had sections; --skip-waterfall drops the
-// waterfall from either. --quick: N = 1000, 3000, ratios at N = 2000, 300 steps (at least 3e6 / N),
-// block 0.5 s + 2 x 0.25 s, the waterfall for 1 s. --csv NAME: write DIR/NAME instead of
-// DIR/throughput.csv (the plot goes beside it with .png). --profile-*: set up the scene (the drum's
-// from the cache, which must exist), run the untimed warm-up, then only STEPS steps in
-// profiled_steps() and print one line with the particle-steps, contact-steps and candidate-steps
-// and the CPU time of those steps alone (ns per particle-step); no table, no files.
+// Without --sections all but order run; --particles without --sections runs the drum section and
+// the waterfall only, as the program did before it had sections; --skip-waterfall drops the
+// waterfall from either. --quick: N = 1000, 3000, deposited 3000, 10000, ratios at N = 2000, 300
+// steps (at least 3e6 / N), block 0.5 s + 2 x 0.25 s, the waterfall for 1 s. --csv NAME: write
+// DIR/NAME instead of DIR/throughput.csv (the plot goes beside it with .png). --profile-*: set up
+// the scene (the drum's from the cache, which must exist), run the untimed warm-up, then only STEPS
+// steps in profiled_steps() and print one line with the particle-steps, contact-steps and
+// candidate-steps and the CPU time of those steps alone (ns per particle-step); no table, no files.
 #include <malloc.h>
 
 #include <algorithm>
@@ -147,10 +157,12 @@ const char* const kDeck = DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in";
 
 struct Options {
   bool quick = false;
-  std::vector<std::string> sections = {"drum", "ratios", "block", "waterfall"};
+  std::vector<std::string> sections = {"drum", "deposited", "ratios", "block", "waterfall"};
   bool plot = true;
   bool cache = true;
-  std::vector<std::int64_t> particles = {1000, 3000, 10000, 30000, 100000, 1000000};
+  std::vector<std::int64_t> particles = {1000, 3000, 10000, 30000, 100000};
+  std::vector<std::int64_t> deposited = {10000, 30000, 100000, 1000000};
+  double deposited_speed = 0.0;
   std::vector<double> ratios = {1.0, 2.0, 5.0, 10.0};
   std::int64_t ratio_particles = 20000;
   std::vector<std::int64_t> order_particles = {100000, 1000000};
@@ -227,8 +239,10 @@ double pair_contacts(const Simulation& sim) {
 }
 
 // Warm-up, memory, then `repeats` timed segments of `steps` steps of a drum or ratio scene.
-Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row row) {
+Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row row,
+                    double speed_factor = 1.0) {
   Scene scene = bench::settled_scene(pk, dt);
+  scene.drum.speed *= speed_factor;
   scene.run.spatial_sort = row.sort;
   if (row.ids == "shuffled") {  // ids follow the order of the [[particle]] list
     std::mt19937_64 random(7);
@@ -301,6 +315,19 @@ Row measure_drum(const Options& opt, std::int64_t n) {
   row.steps = std::min(std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
                        static_cast<std::int64_t>(opt.max_particle_steps / nd));
   row = measure_packing(opt, pk, 1.0e-6, row);
+  print_row(row, settling_of(pk));
+  return row;
+}
+
+Row measure_deposited(const Options& opt, std::int64_t n) {
+  Row row;
+  row.section = "deposited";
+  row.ratio = bench::kRadiusMax / bench::kRadiusMin;
+  const bench::Packing pk = bench::deposited_packing(n, opt.results + "/cache");
+  const auto nd = static_cast<double>(n);
+  row.steps = std::min(std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
+                       static_cast<std::int64_t>(opt.max_particle_steps / nd));
+  row = measure_packing(opt, pk, 1.0e-6, row, opt.deposited_speed);
   print_row(row, settling_of(pk));
   return row;
 }
@@ -457,8 +484,8 @@ std::vector<T> parse_list(const std::string& s) {
 [[noreturn]] void usage(int code) {
   std::fprintf(
       code ? stderr : stdout,
-      "usage: throughput [--sections drum,ratios,block,waterfall,order] [--quick] [--particles "
-      "N1,N2,...]\n"
+      "usage: throughput [--sections drum,deposited,ratios,block,waterfall,order] [--quick]\n"
+      "                  [--particles N1,N2,...] [--deposited N1,N2,...] [--deposited-speed F]\n"
       "                  [--ratios R1,R2,...] [--ratio-particles N] [--steps S] [--repeats R]\n"
       "                  [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot]\n"
       "                  [--no-cache] [--results DIR] [--csv NAME] [--order-particles N1,...]\n"
@@ -469,7 +496,7 @@ std::vector<T> parse_list(const std::string& s) {
 Options parse(int argc, char** argv) {
   Options o;
   bool particles_given = false, steps_given = false, ratio_n_given = false, sections_given = false,
-       skip_waterfall = false;
+       skip_waterfall = false, deposited_given = false;
   for (int k = 1; k < argc; ++k) {
     const std::string a = argv[k];
     auto value = [&]() -> std::string {
@@ -486,7 +513,8 @@ Options parse(int argc, char** argv) {
       o.sections.clear();
       std::stringstream in(value());
       for (std::string s; std::getline(in, s, ',');) {
-        if (s != "drum" && s != "ratios" && s != "block" && s != "waterfall" && s != "order") {
+        if (s != "drum" && s != "deposited" && s != "ratios" && s != "block" && s != "waterfall" &&
+            s != "order") {
           std::fprintf(stderr, "throughput: unknown section '%s'\n", s.c_str());
           usage(2);
         }
@@ -495,6 +523,11 @@ Options parse(int argc, char** argv) {
     } else if (a == "--particles") {
       o.particles = parse_list<std::int64_t>(value());
       particles_given = true;
+    } else if (a == "--deposited") {
+      o.deposited = parse_list<std::int64_t>(value());
+      deposited_given = true;
+    } else if (a == "--deposited-speed") {
+      o.deposited_speed = std::stod(value());
     } else if (a == "--order-particles") {
       o.order_particles = parse_list<std::int64_t>(value());
     } else if (a == "--ratios") {
@@ -537,6 +570,7 @@ Options parse(int argc, char** argv) {
   if (skip_waterfall) std::erase(o.sections, std::string("waterfall"));
   if (o.quick) {
     if (!particles_given) o.particles = {1000, 3000};
+    if (!deposited_given) o.deposited = {3000, 10000};
     if (!ratio_n_given) o.ratio_particles = 2000;
     if (!steps_given) o.steps = 300;
     o.min_particle_steps = 3.0e6;
@@ -644,6 +678,29 @@ void drum_section(const Options& opt, std::vector<Row>& rows) {
   rows.insert(rows.end(), drum.begin(), drum.end());
 }
 
+void deposited_section(const Options& opt, std::vector<Row>& rows) {
+  std::vector<Row> dep;
+  for (std::int64_t n : opt.deposited) {
+    try {
+      dep.push_back(measure_deposited(opt, n));
+    } catch (const std::exception& e) {
+      std::printf("deposited N = %lld failed: %s\n", static_cast<long long>(n), e.what());
+    }
+  }
+  const Row* base = nullptr;
+  for (const Row& r : dep)
+    if (r.n == 10000) base = &r;
+  if (base)
+    for (const Row& r : dep)
+      std::printf(
+          "(d) deposited N = %lld: %.1f ns per particle-step = %.2f x the 1e4 bed's %.1f ns "
+          "(issue 13 target: <= 1.3 x); %.2f contacts and %.2f candidates per particle, %.0f "
+          "bytes of memory per particle\n",
+          static_cast<long long>(r.n), r.ns_cpu(), r.ns_cpu() / base->ns_cpu(), base->ns_cpu(),
+          r.contacts_per_particle, r.candidates_per_particle, r.rss_per_particle);
+  rows.insert(rows.end(), dep.begin(), dep.end());
+}
+
 void ratio_section(const Options& opt, std::vector<Row>& rows) {
   std::vector<Row> rat;
   for (double ratio : opt.ratios) {
@@ -686,6 +743,7 @@ int main(int argc, char** argv) {
   print_header();
   std::vector<Row> rows;
   if (opt.has("drum")) drum_section(opt, rows);
+  if (opt.has("deposited")) deposited_section(opt, rows);
   if (opt.has("ratios")) ratio_section(opt, rows);
   if (opt.has("order")) order_section(opt, rows);
   if (opt.has("block")) {

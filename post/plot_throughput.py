@@ -6,7 +6,8 @@ bench/throughput.
                             [--before bench/results/throughput_before.csv]
 
 Top left: nanoseconds per particle-step (CPU time of the fastest repeat; wall time dotted) of
-the drum runs against the particle count N (1e3 .. 1e6), with the target of 15 million
+the drum runs against the particle count N (1e3 .. 1e5; the deposited beds, 1e4 .. 1e6, as
+triangles with their cost relative to the deposited 1e4 bed and the issue-13 bound of 1.3x), with the target of 15 million
 particle-steps per second (66.7 ns) as a horizontal line; flat means linear scaling. The dense
 sliding block and the waterfall deck are marked at their 240 balls (the block's target,
 40 million particle-steps/s = 25 ns, dashed). Top right: bytes per particle against N: the
@@ -70,6 +71,21 @@ def draw(axes, rows, style, label_suffix, grey=False):
         y = [num(r, "candidates_per_particle") for r in drum]
         if any(v == v for v in y):
             axc.plot(n, y, "^" + style, color=c("tab:olive"), label="candidate pairs" + label_suffix)
+    dep = sorted((r for r in rows if r["section"] == "deposited"), key=lambda r: int(r["n_particles"]))
+    if dep:
+        n = [int(r["n_particles"]) for r in dep]
+        ax.plot(n, [num(r, "ns_per_particle_step_cpu") for r in dep], "v" + style, color=c("tab:cyan"),
+                label="deposited bed, drum still: CPU time" + label_suffix)
+        base = [num(r, "ns_per_particle_step_cpu") for r in dep if int(r["n_particles"]) == 10000]
+        if base and not grey:
+            ax.axhline(1.3 * base[0], color="tab:cyan", linestyle=":",
+                       label=f"1.3 x the deposited 1e4 bed ({1.3 * base[0]:.1f} ns)")
+            for r in dep:
+                ax.annotate(f"{num(r, 'ns_per_particle_step_cpu') / base[0]:.2f}x",
+                            (int(r["n_particles"]), num(r, "ns_per_particle_step_cpu")),
+                            textcoords="offset points", xytext=(4, -12), fontsize=7, color="tab:cyan")
+        axc.plot(n, [num(r, "contacts_per_particle") for r in dep], "v" + style, color=c("tab:cyan"),
+                 label="contacts, deposited beds" + label_suffix)
     for r in rows:
         if r["section"] not in ("waterfall", "block"):
             continue
