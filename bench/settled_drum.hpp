@@ -598,12 +598,19 @@ inline Packing deposit_packing(std::int64_t n, int choices = 4) {
   b.vel.assign(b.pos.size(), dem2d::Vec2{});
   b.spin.assign(b.pos.size(), 0.0);
   b.deposited = true;
+  // The deposition touches, never overlaps: anything above rounding is a bug, and in steel it
+  // would fire the particles apart.
+  double overlap = largest_overlap(b.pos, b.radius);
+  for (std::size_t k = 0; k < b.pos.size(); ++k)
+    overlap = std::max(overlap, dem2d::norm(b.pos[k]) + b.radius[k] - R);
+  if (!(overlap < 1e-9))
+    throw std::runtime_error("settled_drum: the deposition left an overlap of " +
+                             std::to_string(overlap) + " m");
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "deposited (frictionless quasi-static rolling into two-support pockets, lowest of "
                 "%d drop points per disc, %.3g rolls per disc; largest overlap %.3g m)",
-                choices, static_cast<double>(rolls) / static_cast<double>(n),
-                largest_overlap(b.pos, b.radius));
+                choices, static_cast<double>(rolls) / static_cast<double>(n), overlap);
   b.recipe = buf;
   return b;
 }

@@ -11,10 +11,11 @@
 //
 // Scenes:
 //  - drum<N/1000>k for each N of --particles (default 30000: drum30k): the settled charge of
-//    bench/throughput (bench/settled_drum.hpp; N >= 300 000 tiled from the 30 000 packing),
-//    read from DIR/cache/settled_drum_<N>.csv (never settled here: run
-//    build/bench/throughput --sections drum --particles N once; a missing packing is reported
-//    and skipped), drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps
+//    bench/throughput (bench/settled_drum.hpp; N >= 300 000 the deposited bed, in the material
+//    it is loaded in), read from DIR/cache/settled_drum_<N>.csv or deposited_drum_<N>.csv
+//    (never made here: run build/bench/throughput --sections drum --particles N, or
+//    --sections deposited --deposited N, once; a missing packing is reported and skipped),
+//    drum at full speed, dt 1e-6 s; 300 untimed steps, then S timed steps
 //    (default 2000) for N <= 30 000, max(50, S 30 000 / N) above (600 at 1e5, 60 at 1e6).
 //  - waterfall: inputs/waterfall_polygon.in (240 balls), T simulated seconds (default 1);
 //    --no-waterfall leaves it out.
@@ -156,9 +157,9 @@ int worker(const Args& a) {
     if (!pk) {
       if (rank == 0)
         std::fprintf(stderr,
-                     "strong_scaling: no cached packing %s/cache/settled_drum_%lld.csv (run "
+                     "strong_scaling: no cached packing of %lld particles in %s/cache (run "
                      "build/bench/throughput --sections drum --particles %lld): skipped\n",
-                     a.results.c_str(), static_cast<long long>(n), static_cast<long long>(n));
+                     static_cast<long long>(n), a.results.c_str(), static_cast<long long>(n));
       continue;
     }
     const std::int64_t steps =
