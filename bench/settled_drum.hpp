@@ -40,8 +40,10 @@
 //     overlap 3e-12 m (rounding).
 //  2. Loading, drum still, at dt = 1e-6 s in deposited_material() (steel with e = 0.1 and
 //     mu_s = 0.5), in chunks of 1000 steps until the contacts grow by less than 1 % in a chunk
-//     (at least 3, at most 60 chunks): 30 000 spheres reach 1.89 contacts per particle in 9 000
-//     steps, 1e5 in 14 000.
+//     and the mean speed sqrt(2 KE / M) is below 5 cm/s (at least 3, at most 80 chunks): 30 000
+//     spheres reach 1.89 contacts per particle in 9 000 steps, 1e5 in 14 000. (The deeper the
+//     bed, the longer its weight takes to come on: at 1e6 the mean speed was still rising
+//     through 0.15 m/s after 25 000 steps, with 1.69 contacts per particle.)
 // The thesis steel (e = 0.73, mu_s = 0.1) cannot hold a deposited bed: its loose layers keep
 // closing up (30 000: 1.89 contacts per particle after loading, 1.47 after 1 000 more steps, 0.19
 // after 4 500 steps in the turning drum), so deposited beds are measured in deposited_material()
@@ -99,9 +101,10 @@ constexpr double kRadiusMin = 0.006, kRadiusMax = 0.010;  // m
 constexpr double kRefN = 30000.0, kRefDrum = 2.5, kRefSpeed = 1.5;
 constexpr const char* kCacheVersion = "settled_drum v7";  // bump when the recipe changes
 constexpr const char* kRatioCacheVersion = "settled_drum ratio v1";
-constexpr const char* kDepositCacheVersion = "deposited_drum v1";
+constexpr const char* kDepositCacheVersion = "deposited_drum v2";
 constexpr std::int64_t kDepositFrom = 300000;  // settled_packing: N >= this deposited
-constexpr int kDepositLoadChunks = 60;         // of 1000 steps, at most
+constexpr int kDepositLoadChunks = 80;         // of 1000 steps, at most
+constexpr double kDepositLoadedSpeed = 0.05;   // m/s: loaded when the mean speed is below
 constexpr double kFillFraction = 0.31;         // charge area / drum area
 constexpr double kRatioDt = 5.0e-7;            // s: every size-ratio run (1 mm steel spheres)
 
@@ -330,9 +333,11 @@ inline void remove_overlaps(dem2d::Simulation& sim, Packing& out, double radius)
 }
 
 // Stage 3: steel at `dt` with the drum still, in chunks of 1000 steps until the contacts grow by
-// less than 1 % in a chunk (at least 3 chunks, at most `max_chunks`).
+// less than 1 % in a chunk and the mean speed is below `max_speed` (at least 3 chunks, at most
+// `max_chunks`).
 inline void load_in_steel(Packing& out, double dt, int max_chunks = 20,
-                          const dem2d::MaterialSpec& material = steel(1.0)) {
+                          const dem2d::MaterialSpec& material = steel(1.0),
+                          double max_speed = std::numeric_limits<double>::infinity()) {
   dem2d::Simulation steel_sim(packing_scene(out, material, 0.0, dt));
   double mass = 0.0;
   for (std::size_t k = 0; k < steel_sim.particles().n_owned(); ++k)
@@ -348,7 +353,7 @@ inline void load_in_steel(Packing& out, double dt, int max_chunks = 20,
                  c / static_cast<double>(out.pos.size()), out.mean_speed);
     const bool flat = c < 1.01 * contacts;
     contacts = c;
-    if (chunk >= 2 && flat) break;
+    if (chunk >= 2 && flat && out.mean_speed < max_speed) break;
   }
   out.load_steps = steel_sim.step_count();
   out.contacts_per_particle = contacts / static_cast<double>(out.pos.size());
@@ -776,7 +781,7 @@ inline Packing deposited_packing(std::int64_t n, const std::string& cache_dir,
   }
   const auto t0 = std::chrono::steady_clock::now();
   Packing out = deposit_packing(n);
-  load_in_steel(out, 1.0e-6, kDepositLoadChunks, deposited_material());
+  load_in_steel(out, 1.0e-6, kDepositLoadChunks, deposited_material(), kDepositLoadedSpeed);
   out.settle_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::ostringstream head;
   head << kDepositCacheVersion << ": N = " << n << ", drum radius " << drum_radius_for(n) << " m; "
