@@ -532,16 +532,32 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
   const double* r = p.radius.data();
   const std::int32_t* mat = p.material.data();
   const WallElement* elements = walls.elements().data();
+  const WallBody* bodies = walls.bodies().data();
   std::size_t n = 0;
   for (std::size_t k = 0; k < wl.size(); ++k) {
     const std::int32_t i = wl.particle[k];
     for (std::size_t s = 0; s < W; ++s) wl.trial[k * W + s] = 0.0;  // the scatter rewrites contacts
-    // Most candidates do not touch: the cheap test skips the square root and division of the
-    // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).
-    if (!walls.touches(wl.element[k], x[i], r[i])) continue;
-    const WallGeometry g = walls.geometry(wl.element[k], x[i], r[i]);
-    if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit
     const WallElement& e = elements[wl.element[k]];
+    WallGeometry g;
+    if (e.kind == WallKind::kCircle) {
+      // Walls::touches and Walls::geometry of a circle written out: the same operations, so the
+      // same bits, with the cheap test's distance kept and no round trip of the geometry
+      // through memory.
+      const Vec2 c = bodies[e.body].center + bodies[e.body].offset;
+      const Vec2 d = x[i] - c;
+      const double d2 = norm2(d), inner = e.radius - r[i];
+      if (inner > 0.0 && d2 <= inner * inner) continue;
+      const double dist = std::sqrt(d2);
+      g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
+      g.delta = dist + r[i] - e.radius;
+      g.point = c + e.radius * g.n;
+    } else {
+      // Most candidates do not touch: the cheap test skips the square root and division of the
+      // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).
+      if (!walls.touches(wl.element[k], x[i], r[i])) continue;
+      g = walls.geometry(wl.element[k], x[i], r[i]);
+    }
+    if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit
     const Vec2 vw = walls.velocity_at(e.body, g.point);
     const Vec2 vrel = (v[i] - vw) + (w[i] * r[i]) * perp(g.n);
     wb_.pair[n] = static_cast<std::int32_t>(k);
@@ -553,7 +569,7 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     wb_.m[n] = p.mass[i];
     wb_.vx[n] = vrel.x;
     wb_.vy[n] = vrel.y;
-    wb_.omega_rel[n] = w[i] - walls.bodies()[e.body].omega;
+    wb_.omega_rel[n] = w[i] - bodies[e.body].omega;
     for (std::size_t s = 0; s < W; ++s) wb_.history.old[s][n] = wl.history[k * W + s];
     wb_.wx[n] = vw.x;
     wb_.wy[n] = vw.y;
