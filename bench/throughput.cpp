@@ -305,31 +305,37 @@ std::string settling_of(const bench::Packing& pk) {
   return pk.from_cache ? "cache" : std::to_string(std::lround(pk.settle_wall)) + " s";
 }
 
-Row measure_drum(const Options& opt, std::int64_t n) {
+// A drum of n particles: the settled packing, or (`deposited`) the deposited bed with the drum at
+// --deposited-speed.
+Row measure_drum(const Options& opt, std::int64_t n, bool deposited) {
   Row row;
-  row.section = "drum";
+  row.section = deposited ? "deposited" : "drum";
   row.ratio = bench::kRadiusMax / bench::kRadiusMin;
-  const bench::Packing pk =
-      opt.cache ? bench::settled_packing(n, opt.results + "/cache") : bench::settle_packing(n);
+  const std::string cache = opt.results + "/cache";
+  const bench::Packing pk = deposited   ? bench::deposited_packing(n, cache)
+                            : opt.cache ? bench::settled_packing(n, cache)
+                                        : bench::settle_packing(n);
   const auto nd = static_cast<double>(n);
   row.steps = std::min(std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
                        static_cast<std::int64_t>(opt.max_particle_steps / nd));
-  row = measure_packing(opt, pk, 1.0e-6, row);
+  row = measure_packing(opt, pk, 1.0e-6, row, deposited ? opt.deposited_speed : 1.0);
   print_row(row, settling_of(pk));
   return row;
 }
 
-Row measure_deposited(const Options& opt, std::int64_t n) {
-  Row row;
-  row.section = "deposited";
-  row.ratio = bench::kRadiusMax / bench::kRadiusMin;
-  const bench::Packing pk = bench::deposited_packing(n, opt.results + "/cache");
-  const auto nd = static_cast<double>(n);
-  row.steps = std::min(std::max(opt.steps, static_cast<std::int64_t>(opt.min_particle_steps / nd)),
-                       static_cast<std::int64_t>(opt.max_particle_steps / nd));
-  row = measure_packing(opt, pk, 1.0e-6, row, opt.deposited_speed);
-  print_row(row, settling_of(pk));
-  return row;
+// measure_drum for each size; a size that fails is reported and left out.
+std::vector<Row> measure_drums(const Options& opt, const std::vector<std::int64_t>& sizes,
+                               bool deposited) {
+  std::vector<Row> out;
+  for (std::int64_t n : sizes) {
+    try {
+      out.push_back(measure_drum(opt, n, deposited));
+    } catch (const std::exception& e) {
+      std::printf("%s N = %lld failed: %s\n", deposited ? "deposited" : "drum",
+                  static_cast<long long>(n), e.what());
+    }
+  }
+  return out;
 }
 
 Row measure_ratio(const Options& opt, double ratio) {
@@ -646,14 +652,7 @@ void order_section(const Options& opt, std::vector<Row>& rows) {
 }
 
 void drum_section(const Options& opt, std::vector<Row>& rows) {
-  std::vector<Row> drum;
-  for (std::int64_t n : opt.particles) {
-    try {
-      drum.push_back(measure_drum(opt, n));
-    } catch (const std::exception& e) {
-      std::printf("N = %lld failed: %s\n", static_cast<long long>(n), e.what());
-    }
-  }
+  const std::vector<Row> drum = measure_drums(opt, opt.particles, false);
   if (drum.empty()) return;
   const Row* a = &drum.back();
   for (const Row& r : drum)
@@ -679,14 +678,7 @@ void drum_section(const Options& opt, std::vector<Row>& rows) {
 }
 
 void deposited_section(const Options& opt, std::vector<Row>& rows) {
-  std::vector<Row> dep;
-  for (std::int64_t n : opt.deposited) {
-    try {
-      dep.push_back(measure_deposited(opt, n));
-    } catch (const std::exception& e) {
-      std::printf("deposited N = %lld failed: %s\n", static_cast<long long>(n), e.what());
-    }
-  }
+  const std::vector<Row> dep = measure_drums(opt, opt.deposited, true);
   const Row* base = nullptr;
   for (const Row& r : dep)
     if (r.n == 10000) base = &r;
