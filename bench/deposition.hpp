@@ -19,6 +19,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/vec2.hpp"
@@ -56,80 +57,31 @@ class Deposition {
       if (move > 10000) throw std::runtime_error("deposition: a disc found no rest");
       ++rolls_;
       // Roll on `support` (-1: the wall) from c, downhill, to the end of its arc.
-      dem2d::Vec2 p{0.0, 0.0};
-      double rho = rw, theta0 = std::atan2(c.y, c.x), theta_end = -0.5 * std::numbers::pi, dir;
+      Arc arc{{0.0, 0.0}, rw, std::atan2(c.y, c.x), -1.0, -0.5 * std::numbers::pi};
       if (support >= 0) {
-        p = x_[static_cast<std::size_t>(support)];
-        rho = r + r_[static_cast<std::size_t>(support)];
-        theta0 = std::atan2(c.y - p.y, c.x - p.x);
-        if (!(std::sin(theta0) > 0.0)) {  // at or below its support's equator: falls off
+        arc.p = x_[static_cast<std::size_t>(support)];
+        arc.rho = r + r_[static_cast<std::size_t>(support)];
+        arc.theta0 = std::atan2(c.y - arc.p.y, c.x - arc.p.x);
+        if (!(std::sin(arc.theta0) > 0.0)) {  // at or below its support's equator: falls off
           support = fall(c, r, support);
           continue;
         }
-        const bool right = c.x > p.x || (c.x == p.x && tie);
-        dir = right ? -1.0 : 1.0;
-        theta_end = right ? 0.0 : std::numbers::pi;
+        const bool right = c.x > arc.p.x || (c.x == arc.p.x && tie);
+        arc.dir = right ? -1.0 : 1.0;
+        arc.theta_end = right ? 0.0 : std::numbers::pi;
       } else {
         if (!(c.y < 0.0))
-          throw std::runtime_error("deposition: a disc on the upper wall " + std::to_string(c.x) +
-                                   " " + std::to_string(c.y) + " n=" + std::to_string(x_.size()) +
-                                   " move " + std::to_string(move));
+          throw std::runtime_error(
+              "deposition: a disc reached the drum's wall above its centre "
+              "(the charge is deeper than the drum's lower half)");
         if (c.x == 0.0) break;  // the lowest point of the wall
-        if (c.x < 0.0 && theta0 > 0.0) theta0 -= 2.0 * std::numbers::pi;
-        dir = c.x > 0.0 ? -1.0 : 1.0;
+        if (c.x < 0.0 && arc.theta0 > 0.0) arc.theta0 -= 2.0 * std::numbers::pi;
+        arc.dir = c.x > 0.0 ? -1.0 : 1.0;
       }
-      const double span = std::abs(theta_end - theta0);
-      // The first obstacle along the arc: the angle travelled and what is hit (-1: the wall).
-      double best = span;
-      int hit = -3;
-      auto consider = [&](dem2d::Vec2 q, double reach, int who) {
-        // The arc's centres closer than `reach` to q form an interval of angles around q's
-        // direction; the arc enters it at its near end.
-        const dem2d::Vec2 d = q - p;
-        const double dist = dem2d::norm(d);
-        if (dist == 0.0) return;
-        const double cosa = (rho * rho + dist * dist - reach * reach) / (2.0 * rho * dist);
-        if (cosa >= 1.0 || cosa <= -1.0) return;
-        const double entry = std::atan2(d.y, d.x) - dir * std::acos(cosa);
-        double travel = std::remainder(dir * (entry - theta0), 2.0 * std::numbers::pi);
-        if (travel < 0.0) {
-          if (travel > -1e-9)
-            travel = 0.0;  // already touching it and moving into it
-          else
-            travel += 2.0 * std::numbers::pi;
-        }
-        if (travel < best) {
-          best = travel;
-          hit = who;
-        }
-      };
-      if (support >= 0) {
-        // The wall: the arc leaves the circle of radius rw; reach is measured from the origin
-        // to the arc as the complement (centres farther than rw from the origin).
-        const double dist = dem2d::norm(p);
-        if (dist > 0.0) {
-          const double cosb = (rw * rw - dist * dist - rho * rho) / (2.0 * rho * dist);
-          if (cosb > -1.0 && cosb < 1.0) {
-            const double entry = std::atan2(p.y, p.x) - dir * std::acos(cosb);
-            double travel = std::remainder(dir * (entry - theta0), 2.0 * std::numbers::pi);
-            if (travel < 0.0) travel = travel > -1e-9 ? 0.0 : travel + 2.0 * std::numbers::pi;
-            if (travel < best) {
-              best = travel;
-              hit = -1;
-            }
-          }
-        }
-        near(p, rho + r + r_max_, [&](int k) {
-          if (k != support)
-            consider(x_[static_cast<std::size_t>(k)], r + r_[static_cast<std::size_t>(k)], k);
-        });
-      } else {
-        for (int k : at_wall_)
-          consider(x_[static_cast<std::size_t>(k)], r + r_[static_cast<std::size_t>(k)], k);
-      }
-      const double theta = theta0 + dir * best;
-      c = p + rho * dem2d::Vec2{std::cos(theta), std::sin(theta)};
-      if (hit == -3) {           // nothing on the way
+      const auto [travel, hit] = first_obstacle(arc, r, support);
+      const double theta = arc.theta0 + arc.dir * travel;
+      c = arc.p + arc.rho * dem2d::Vec2{std::cos(theta), std::sin(theta)};
+      if (hit == kNothing) {     // nothing on the way
         if (support < 0) break;  // the lowest point of the wall
         support = fall(c, r, support);
         continue;
@@ -149,6 +101,57 @@ class Deposition {
   }
 
  private:
+  static constexpr int kNothing = -3;  // first_obstacle: the arc is free to its end
+
+  // The arc a rolling disc's centre follows: centre p, radius rho, from angle theta0 in the
+  // direction dir (+1 counterclockwise) to theta_end.
+  struct Arc {
+    dem2d::Vec2 p;
+    double rho, theta0, dir, theta_end;
+  };
+
+  // The first obstacle on the arc of a disc of radius r rolling on `support`: the angle travelled
+  // to it and what it is (a disc, -1: the wall, kNothing: none up to theta_end).
+  std::pair<double, int> first_obstacle(const Arc& arc, double r, int support) const {
+    double best = std::abs(arc.theta_end - arc.theta0);
+    int hit = kNothing;
+    // The arc's points on one side of a circle form an interval of angles about `centre`
+    // (half-width `half`); the arc enters it at its near end.
+    auto enter = [&](double centre, double half, int who) {
+      const double entry = centre - arc.dir * half;
+      double travel = std::remainder(arc.dir * (entry - arc.theta0), 2.0 * std::numbers::pi);
+      if (travel < 0.0)  // behind: unless touching it already and moving into it
+        travel = travel > -1e-9 ? 0.0 : travel + 2.0 * std::numbers::pi;
+      if (travel < best) {
+        best = travel;
+        hit = who;
+      }
+    };
+    // Disc k: centres closer than r + r_k to its centre (law of cosines in the triangle p, q, c).
+    auto disc = [&](int k) {
+      const dem2d::Vec2 d = x_[static_cast<std::size_t>(k)] - arc.p;
+      const double dist = dem2d::norm(d), reach = r + r_[static_cast<std::size_t>(k)];
+      if (dist == 0.0) return;
+      const double cosa =
+          (arc.rho * arc.rho + dist * dist - reach * reach) / (2.0 * arc.rho * dist);
+      if (cosa > -1.0 && cosa < 1.0) enter(std::atan2(d.y, d.x), std::acos(cosa), k);
+    };
+    if (support >= 0) {
+      // The wall: centres farther than R - r from the origin, about the direction of p.
+      const double rw = R_ - r, dist = dem2d::norm(arc.p);
+      if (dist > 0.0) {
+        const double cosb = (rw * rw - dist * dist - arc.rho * arc.rho) / (2.0 * arc.rho * dist);
+        if (cosb > -1.0 && cosb < 1.0) enter(std::atan2(arc.p.y, arc.p.x), std::acos(cosb), -1);
+      }
+      near(arc.p, arc.rho + r + r_max_, [&](int k) {
+        if (k != support) disc(k);
+      });
+    } else {
+      for (int k : at_wall_) disc(k);
+    }
+    return {best, hit};
+  }
+
   // Unit normal at the disc's centre c from support k (-1: the wall pushes towards the centre).
   dem2d::Vec2 normal_from(int k, dem2d::Vec2 c) const {
     const dem2d::Vec2 d = k >= 0 ? c - x_[static_cast<std::size_t>(k)] : -c;
