@@ -540,17 +540,13 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     const WallElement& e = elements[wl.element[k]];
     WallGeometry g;
     if (e.kind == WallKind::kCircle) {
-      // Walls::touches and Walls::geometry of a circle written out: the same operations, so the
-      // same bits, with the cheap test's distance kept and no round trip of the geometry
-      // through memory.
-      const Vec2 c = bodies[e.body].center + bodies[e.body].offset;
+      // The circle's test and geometry of Walls::touches and Walls::geometry, with the cheap
+      // test's distance kept for the geometry.
+      const Vec2 c = walls.circle_center(e);
       const Vec2 d = x[i] - c;
-      const double d2 = norm2(d), inner = e.radius - r[i];
-      if (inner > 0.0 && d2 <= inner * inner) continue;
-      const double dist = std::sqrt(d2);
-      g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
-      g.delta = dist + r[i] - e.radius;
-      g.point = c + e.radius * g.n;
+      const double d2 = norm2(d);
+      if (clear_inside_circle(e.radius, r[i], d2)) continue;
+      g = circle_geometry(c, e.radius, d, std::sqrt(d2), r[i]);
     } else {
       // Most candidates do not touch: the cheap test skips the square root and division of the
       // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).

@@ -52,6 +52,24 @@ struct WallGeometry {
   Vec2 point{};        // contact point on the wall
 };
 
+// A sphere of radius r inside a circle of radius R, its centre at d from the circle's centre c
+// (d2 = |d|^2, dist = |d|). Walls and the force kernel's wall gather share these two, so that
+// both compute the same bits.
+// Clear of the circle (no contact): without the square root of the full geometry.
+[[gnu::always_inline]] inline bool clear_inside_circle(double R, double r, double d2) {
+  const double inner = R - r;
+  return inner > 0.0 && d2 <= inner * inner;
+}
+// delta = |d| + r - R, the normal from the sphere towards the shell, the point on the shell.
+[[gnu::always_inline]] inline WallGeometry circle_geometry(Vec2 c, double R, Vec2 d, double dist,
+                                                           double r) {
+  WallGeometry g;
+  g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
+  g.delta = dist + r - R;
+  g.point = c + R * g.n;
+  return g;
+}
+
 class Walls {
  public:
   Walls() = default;
@@ -63,29 +81,24 @@ class Walls {
   WallGeometry geometry(int element, Vec2 x, double r) const {
     const WallElement& e = elements_[element];
     if (e.kind != WallKind::kCircle) return segment_geometry(e, x, r);
-    // Inside a circle of radius R about the body's centre: delta = |x - c| + r - R.
-    WallGeometry g;
-    const Vec2 c = bodies_[e.body].center + bodies_[e.body].offset;
+    const Vec2 c = circle_center(e);
     const Vec2 d = x - c;
-    const double dist = norm(d);
-    g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
-    g.delta = dist + r - e.radius;
-    g.point = c + e.radius * g.n;
-    return g;
+    return circle_geometry(c, e.radius, d, norm(d), r);
   }
   // Whether a sphere at x of radius r overlaps the element (geometry(...).delta > 0) without
   // the square root and division of the full geometry: the cheap test of the force kernel.
   bool touches(int element, Vec2 x, double r) const {
     const WallElement& e = elements_[element];
-    if (e.kind == WallKind::kCircle) {
-      const double inner = e.radius - r;
-      return inner <= 0.0 ||
-             !(norm2(x - (bodies_[e.body].center + bodies_[e.body].offset)) <= inner * inner);
-    }
+    if (e.kind == WallKind::kCircle)
+      return !clear_inside_circle(e.radius, r, norm2(x - circle_center(e)));
     const Vec2 ab = e.b - e.a;
     const double len2 = norm2(ab);
     const double s = len2 > 0.0 ? std::clamp(dot(x - e.a, ab) / len2, 0.0, 1.0) : 0.0;
     return !(norm2(e.a + s * ab - x) >= r * r);
+  }
+  // The centre of a circle element (its body's centre at the current time).
+  Vec2 circle_center(const WallElement& e) const {
+    return bodies_[e.body].center + bodies_[e.body].offset;
   }
   Vec2 velocity_at(int body, Vec2 p) const {
     const WallBody& b = bodies_[body];
