@@ -93,7 +93,7 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
   opt.repartition_threshold = scene.run.repartition_threshold;
   MpiDomain domain(comm, opt);
   Simulation sim(scene, &domain);
-  for (int k = 0; k < untimed; ++k) sim.step();
+  for (int k = 0; k < untimed; ++k) sim.step(/*end_observed=*/k + 1 == untimed);
   // The machine is shared: the timed segment is repeated (the run continues) and the fastest
   // of the repeats is kept, for the communication share too.
   double wall = 1e300, comm_max = 0.0, compute_max = 0.0, slowest = 0.0, cpu_max = 0.0;
@@ -101,7 +101,7 @@ Row measure(const std::string& name, const Scene& scene, int untimed, std::int64
     const double comm0 = domain.stats().comm_seconds;
     MPI_Barrier(comm);
     const double t0 = MPI_Wtime(), c0 = cpu_seconds();
-    for (std::int64_t k = 0; k < steps; ++k) sim.step();
+    for (std::int64_t k = 0; k < steps; ++k) sim.step(/*end_observed=*/k + 1 == steps);
     const double local = MPI_Wtime() - t0, cpu_local = cpu_seconds() - c0;
     double cpu_seg = 0.0;
     MPI_Allreduce(&cpu_local, &cpu_seg, 1, MPI_DOUBLE, MPI_MAX, comm);

@@ -322,6 +322,16 @@ class RunLoop {
     if (sim_.spectra()) write_collisions(MPI_COMM_WORLD, scene_.output.directory, *sim_.spectra());
   }
   void after_step();
+  // Whether anything reads the particles after the coming step: an output or checkpoint due at
+  // its time, the stop poll, the end of the run (else the step may run ahead: Simulation::step).
+  bool observes_next_step() const {
+    const OutputSpec& out = scene_.output;
+    const std::int64_t next = sim_.step_count() + 1;
+    const double t = static_cast<double>(next) * sim_.dt();
+    return next % kStopPollSteps == 0 || t + 0.5 * sim_.dt() >= scene_.run.duration ||
+           at_multiple(t, out.series_interval) || at_multiple(t, out.snapshot_interval) ||
+           at_multiple(t, out.checkpoint_interval);
+  }
   // The logs' records up to now first: a restart keeps the rows up to the checkpoint's time.
   void checkpoint() {
     ore_.write(sim_);
@@ -356,7 +366,7 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
   }
   try {
     while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
-      sim_.step();
+      sim_.step(observes_next_step());
       after_step();
       if (sim_.step_count() % kStopPollSteps == 0 && stop_requested())
         return finish(Ending::kInterrupted);

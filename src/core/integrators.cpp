@@ -58,15 +58,24 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
     std::fill(p.elastic_force.data(), p.elastic_force.data() + p.n_owned(), Vec2{});
     elastic_cleared_ = true;
   }
-  kick_drift_owned(p, dt_, s.drift_mirror());  // v += a dt/2, x += v dt; accumulators cleared
+  // v += a dt/2, x += v dt; accumulators cleared (done by the last step when it ran ahead)
+  if (!ahead_) kick_drift_owned(p, dt_, s.drift_mirror());
+  ahead_ = false;
   s.advance_clock();
-  if (rebuild_next_)  // decided in the previous step's round
+  const bool rebuilds = rebuild_next_;  // decided in the previous step's round
+  if (rebuilds)
     s.rebuild();
   else if (!ghosts_ahead_)
     s.refresh_ghosts();
   ghosts_ahead_ = false;
   s.contact_forces(dt_, /*owned_cleared=*/true);
-  const Closing closing = closing_kick(p, s.rebuilds().positions_at_build());  // v += a dt/2
+  // v += a dt/2, and when allowed the next step's kick-drift in the same pass. Not after a
+  // rebuild: the simulation keeps a backup of the state then.
+  const Vec2* x_build = s.rebuilds().positions_at_build();
+  ahead_ = run_ahead_allowed_ && !rebuilds;
+  const ClosingKick closing = ahead_
+                                  ? closing_kick_drift(p, x_build, dt_, gravity_, s.drift_mirror())
+                                  : closing_kick(p, x_build, dt_, gravity_);
   s.commit(dt_, closing.late_loss);
   passes_.add(1);
   return end_of_step_round(s, closing);
@@ -145,8 +154,7 @@ void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror, bool 
         p.mass.data(), p.material.data(), mirror, four_at_a_time);
 }
 
-// The closing half kick fused with the accelerations, and the two maxima of the next step's
-// displacement bound.
+// The closing half kick (closing_kick, closing_kick_drift).
 // The energy ledger's completion: Verlet applies the force F of step n+1 over the closing half
 // kick and the next opening one, so its work on the kinetic energy is exactly F . v(n+1) dt, with
 // v(n+1) the velocity after this kick. The contact laws booked their losses with the half-step
@@ -156,38 +164,233 @@ void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror, bool 
 // on i).
 // Without it the ledger drifted at first order in dt (0.33 % of the drive work over 10 s of the
 // waterfall at 1e-5 s).
-VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec2* x_build) const {
-  const double h = 0.5 * dt_;
-  const std::size_t n = p.n_owned();
-  Vec2* a = p.acc.data();
-  double* al = p.alpha.data();
-  Vec2* v = p.vel.data();
-  double* w = p.omega.data();
-  const Vec2* x = p.pos.data();
-  const Vec2* f = p.force.data();
-  const double* tq = p.torque.data();
-  const double* inv_m = p.inv_mass.data();
-  const double* inv_i = p.inv_inertia.data();
-  const double* r = p.radius.data();
-  Vec2* f_el = p.elastic_force.data();
-  const Vec2 g = gravity_;
-  double checksum = 0.0, disp2 = 0.0, speed2 = 0.0, motion2 = 0.0, late_power = 0.0;
-#pragma omp simd reduction(+ : checksum, late_power) reduction(max : disp2, speed2, motion2)
-  for (std::size_t k = 0; k < n; ++k) {
-    accelerate(a[k], al[k], f[k], tq[k], inv_m[k], inv_i[k], g);
-    checksum += (a[k].x + a[k].y) + al[k] + (x[k].x + x[k].y);
-    v[k] += h * a[k];
-    w[k] += h * al[k];
-    late_power += dot(f[k] - f_el[k], h * a[k]) + tq[k] * (h * al[k]);
-    f_el[k] = {};  // cleared here, where it is read, rather than with the force in kick_drift
-    const double d2 = norm2(x[k] - x_build[k]);
-    const double s2 = norm2(v[k] + h * a[k]);
-    const double m2 = s2 / (r[k] * r[k]);
-    disp2 = disp2 > d2 ? disp2 : d2;
-    speed2 = speed2 > s2 ? speed2 : s2;
-    motion2 = motion2 > m2 ? motion2 : m2;
+namespace {
+
+constexpr std::size_t kSumLanes = 8;
+
+// The closing sums in their fixed order (ClosingKick): particle k of the first whole eights into
+// lane k mod 8, the rest into lane 0.
+struct ClosingSums {
+  double checksum[kSumLanes] = {};
+  double late_power[kSumLanes] = {};
+  double disp2 = 0.0, speed2 = 0.0, motion2 = 0.0;
+  ClosingKick result(double dt) const {
+    ClosingKick c{0.0, disp2, speed2, motion2, 0.0};
+    double late = 0.0;
+    for (std::size_t l = 0; l < kSumLanes; ++l) {
+      c.checksum += checksum[l];
+      late += late_power[l];
+    }
+    c.late_loss = -dt * late;
+    return c;
   }
-  return {checksum, disp2, speed2, motion2, -dt_ * late_power};
+};
+
+// The columns the closing kick (and the drift) read and write; `mirror` may be null.
+struct ClosingColumns {
+  Vec2 *a, *v, *x, *f, *f_el;
+  double *al, *w, *th, *tq;
+  const double *inv_m, *inv_i, *r, *m;
+  const std::int32_t* mat;
+  const Vec2* x_build;
+  PairKinematics* mirror;
+};
+
+ClosingColumns closing_columns(ParticleStore& p, const Vec2* x_build, PairKinematics* mirror) {
+  return {p.acc.data(),
+          p.vel.data(),
+          p.pos.data(),
+          p.force.data(),
+          p.elastic_force.data(),
+          p.alpha.data(),
+          p.omega.data(),
+          p.theta.data(),
+          p.torque.data(),
+          p.inv_mass.data(),
+          p.inv_inertia.data(),
+          p.radius.data(),
+          p.mass.data(),
+          p.material.data(),
+          x_build,
+          mirror};
+}
+
+// The closing half kick of particle k, its share of the sums in `lane`.
+[[gnu::always_inline]] inline void close_one(std::size_t k, std::size_t lane, double h, Vec2 g,
+                                             const ClosingColumns& c, ClosingSums& sums) {
+  accelerate(c.a[k], c.al[k], c.f[k], c.tq[k], c.inv_m[k], c.inv_i[k], g);
+  sums.checksum[lane] += (c.a[k].x + c.a[k].y) + c.al[k] + (c.x[k].x + c.x[k].y);
+  c.v[k] += h * c.a[k];
+  c.w[k] += h * c.al[k];
+  sums.late_power[lane] += dot(c.f[k] - c.f_el[k], h * c.a[k]) + c.tq[k] * (h * c.al[k]);
+  c.f_el[k] = {};  // cleared here, where it is read, rather than with the force in kick_drift
+  const double d2 = norm2(c.x[k] - c.x_build[k]);
+  const double s2 = norm2(c.v[k] + h * c.a[k]);
+  const double m2 = s2 / (c.r[k] * c.r[k]);
+  sums.disp2 = sums.disp2 > d2 ? sums.disp2 : d2;
+  sums.speed2 = sums.speed2 > s2 ? sums.speed2 : s2;
+  sums.motion2 = sums.motion2 > m2 ? sums.motion2 : m2;
+}
+
+// The next step's kick-drift of particle k, after close_one (kick_drift, as kick_drift_owned).
+[[gnu::always_inline]] inline void drift_one(std::size_t k, double h, double dt,
+                                             const ClosingColumns& c) {
+  const Drifted d = kick_drift(c.x[k], c.v[k], c.a[k], c.w[k], c.al[k], h, dt);
+  c.x[k] = d.x;
+  c.v[k] = d.v;
+  c.w[k] = d.w;
+  c.th[k] += dt * d.w;
+  c.f[k] = {};
+  c.tq[k] = 0.0;
+#if DEM2D_VECTOR_GATHER
+  if (c.mirror) store_kinematics(c.mirror[k], c.x[k], c.v[k], d.w, c.r[k], c.m[k], c.mat[k]);
+#endif
+}
+
+std::size_t sum_lane(std::size_t k, std::size_t whole) { return k < whole ? k % kSumLanes : 0; }
+
+#if DEM2D_VECTOR_GATHER
+// Four particles' (x, y) pairs -> x + y of each, in four lanes.
+[[gnu::always_inline]] inline __m256d pair_sums(__m512d u) {
+  const __m512i evens = _mm512_setr_epi64(0, 2, 4, 6, 0, 2, 4, 6);
+  return _mm512_castpd512_pd256(
+      _mm512_permutexvar_pd(evens, _mm512_add_pd(u, _mm512_permute_pd(u, 0x55))));
+}
+// Four per-particle values, each twice (beside a Vec2 column).
+[[gnu::always_inline]] inline __m512d twice(const double* q) {
+  const __m512i pairs = _mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3);
+  return _mm512_permutexvar_pd(pairs, _mm512_zextpd256_pd512(_mm256_loadu_pd(q)));
+}
+// `most > next ? most : next` of close_one, four lanes at once.
+[[gnu::always_inline]] inline __m256d keep_larger(__m256d most, __m256d next) {
+  return _mm256_blendv_pd(next, most, _mm256_cmp_pd(most, next, _CMP_GT_OQ));
+}
+
+struct FourMaxima {
+  __m256d disp2 = _mm256_setzero_pd(), speed2 = _mm256_setzero_pd(), motion2 = _mm256_setzero_pd();
+};
+
+// close_one (and with kDrift drift_one) of particles k..k+3: the same operations in the same
+// order (no FMA); their shares of the sums into `checksum` and `late` (their lanes).
+template <bool kDrift>
+[[gnu::always_inline]] inline void close_four(std::size_t k, double h, double dt, Vec2 g,
+                                              const ClosingColumns& c, FourMaxima& most,
+                                              __m256d& checksum, __m256d& late) {
+  const __m512d F = _mm512_loadu_pd(&c.f[k].x);
+  const __m256d T = _mm256_loadu_pd(c.tq + k);
+  const __m512d A = _mm512_add_pd(_mm512_mul_pd(twice(c.inv_m + k), F),
+                                  _mm512_setr_pd(g.x, g.y, g.x, g.y, g.x, g.y, g.x, g.y));
+  const __m256d AL = _mm256_mul_pd(_mm256_loadu_pd(c.inv_i + k), T);
+  const __m512d X = _mm512_loadu_pd(&c.x[k].x);
+  checksum = _mm256_add_pd(checksum, _mm256_add_pd(_mm256_add_pd(pair_sums(A), AL), pair_sums(X)));
+  const __m512d hA = _mm512_mul_pd(_mm512_set1_pd(h), A);
+  const __m256d hAL = _mm256_mul_pd(_mm256_set1_pd(h), AL);
+  const __m512d V = _mm512_add_pd(_mm512_loadu_pd(&c.v[k].x), hA);
+  const __m256d W = _mm256_add_pd(_mm256_loadu_pd(c.w + k), hAL);
+  const __m512d G = _mm512_sub_pd(F, _mm512_loadu_pd(&c.f_el[k].x));
+  late = _mm256_add_pd(late, _mm256_add_pd(pair_sums(_mm512_mul_pd(G, hA)), _mm256_mul_pd(T, hAL)));
+  const __m512d D = _mm512_sub_pd(X, _mm512_loadu_pd(&c.x_build[k].x));
+  // The next step's opening half kick: v + a dt/2 (also the speed of the round's bound).
+  const __m512d V_half = _mm512_add_pd(V, hA);
+  const __m256d s2 = pair_sums(_mm512_mul_pd(V_half, V_half));
+  const __m256d rk = _mm256_loadu_pd(c.r + k);
+  most.disp2 = keep_larger(most.disp2, pair_sums(_mm512_mul_pd(D, D)));
+  most.speed2 = keep_larger(most.speed2, s2);
+  most.motion2 = keep_larger(most.motion2, _mm256_div_pd(s2, _mm256_mul_pd(rk, rk)));
+  _mm512_storeu_pd(&c.a[k].x, A);
+  _mm256_storeu_pd(c.al + k, AL);
+  _mm512_storeu_pd(&c.f_el[k].x, _mm512_setzero_pd());
+  if constexpr (!kDrift) {
+    _mm512_storeu_pd(&c.v[k].x, V);
+    _mm256_storeu_pd(c.w + k, W);
+    return;
+  }
+  const __m512d X_new = _mm512_add_pd(X, _mm512_mul_pd(_mm512_set1_pd(dt), V_half));
+  const __m256d W_half = _mm256_add_pd(W, hAL);
+  _mm512_storeu_pd(&c.x[k].x, X_new);
+  _mm512_storeu_pd(&c.v[k].x, V_half);
+  _mm256_storeu_pd(c.w + k, W_half);
+  _mm256_storeu_pd(c.th + k, _mm256_add_pd(_mm256_loadu_pd(c.th + k),
+                                           _mm256_mul_pd(_mm256_set1_pd(dt), W_half)));
+  _mm512_storeu_pd(&c.f[k].x, _mm512_setzero_pd());
+  _mm256_storeu_pd(c.tq + k, _mm256_setzero_pd());
+  if (c.mirror) store_kinematics4(c.mirror + k, X_new, V_half, W_half, c.r + k, c.m + k, c.mat + k);
+}
+
+// close_four over particles [0, 8 floor(n / 8)), eight per iteration (the sums' lanes 0-3 and
+// 4-7 in two registers each). Returns where it stopped.
+template <bool kDrift>
+std::size_t close_fours(std::size_t n, double h, double dt, Vec2 g, const ClosingColumns& c,
+                        ClosingSums& sums) {
+  FourMaxima most;
+  __m256d checksum[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+  __m256d late[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+  const std::size_t whole = n / kSumLanes * kSumLanes;
+  for (std::size_t k = 0; k < whole; k += 8) {
+    close_four<kDrift>(k, h, dt, g, c, most, checksum[0], late[0]);
+    close_four<kDrift>(k + 4, h, dt, g, c, most, checksum[1], late[1]);
+  }
+  for (std::size_t half = 0; half < 2; ++half) {
+    _mm256_storeu_pd(sums.checksum + 4 * half, checksum[half]);
+    _mm256_storeu_pd(sums.late_power + 4 * half, late[half]);
+  }
+  alignas(32) double lanes[3][4];
+  _mm256_store_pd(lanes[0], most.disp2);
+  _mm256_store_pd(lanes[1], most.speed2);
+  _mm256_store_pd(lanes[2], most.motion2);
+  for (std::size_t l = 0; l < 4; ++l) {
+    sums.disp2 = sums.disp2 > lanes[0][l] ? sums.disp2 : lanes[0][l];
+    sums.speed2 = sums.speed2 > lanes[1][l] ? sums.speed2 : lanes[1][l];
+    sums.motion2 = sums.motion2 > lanes[2][l] ? sums.motion2 : lanes[2][l];
+  }
+  return whole;
+}
+#endif
+
+// closing_kick (kDrift false) and closing_kick_drift (true).
+template <bool kDrift>
+ClosingKick close(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                  PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time) {
+  const double h = 0.5 * dt;
+  const std::size_t n = p.n_owned(), whole = n / kSumLanes * kSumLanes;
+  const ClosingColumns c = closing_columns(p, x_build, mirror);
+  ClosingSums sums;
+  std::size_t from = 0;
+#if DEM2D_VECTOR_GATHER
+  if (four_at_a_time) from = close_fours<kDrift>(n, h, dt, gravity, c, sums);
+#endif
+  for (std::size_t k = from; k < n; ++k) {
+    close_one(k, sum_lane(k, whole), h, gravity, c, sums);
+    if constexpr (kDrift) drift_one(k, h, dt, c);
+  }
+  return sums.result(dt);
+}
+
+}  // namespace
+
+ClosingKick closing_kick(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                         bool four_at_a_time) {
+  return close<false>(p, x_build, dt, gravity, nullptr, four_at_a_time);
+}
+
+ClosingKick closing_kick_drift(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                               PairKinematics* mirror, bool four_at_a_time) {
+  return close<true>(p, x_build, dt, gravity, mirror, four_at_a_time);
+}
+
+// The drift taken back (a failed step's report): x - dt v, v - a dt/2, w - alpha dt/2,
+// theta - dt w, which gives the step's end state to the last bits, not exactly. The forces of
+// the step are not restored (cleared for the next step).
+void VelocityVerlet::step_back(ParticleStore& p) {
+  if (!ahead_) return;
+  const double h = 0.5 * dt_;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    p.theta[k] -= dt_ * p.omega[k];
+    p.pos[k] -= dt_ * p.vel[k];
+    p.vel[k] -= h * p.acc[k];
+    p.omega[k] -= h * p.alpha[k];
+  }
+  ahead_ = false;
 }
 
 // The step's one collective: stability, and whether the next step rebuilds. The next drift
@@ -196,7 +399,7 @@ VelocityVerlet::Closing VelocityVerlet::closing_kick(ParticleStore& p, const Vec
 // their speed times dt more. In parallel the same round hands the ghosts the state their owners
 // drift them to next, and the next step skips the refresh (wasted when it rebuilds, one step in
 // a hundred or more).
-StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
+StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& c) {
   const double motion = dt_ * std::sqrt(c.motion2);
   const bool local_ok = std::isfinite(c.checksum) && s.totals().max_overlap <= kMaxOverlapRatio &&
                         motion <= kMaxStepMotion;
@@ -214,9 +417,11 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const Closing& c) {
   StepOutcome out{reduce[0] != 0.0, c.checksum, motion};
   if (out.unstable && motion > kMaxStepMotion) {  // name the particle (rare: only now)
     const ParticleStore& p = s.particles();
-    for (std::size_t k = 0; k < p.n_owned() && out.motion_id < 0; ++k)
-      if (dt_ * norm(p.vel[k] + (0.5 * dt_) * p.acc[k]) / p.radius[k] > kMaxStepMotion)
-        out.motion_id = p.id[k];
+    for (std::size_t k = 0; k < p.n_owned() && out.motion_id < 0; ++k) {
+      // The coming drift's velocity: in the store already when the step ran ahead.
+      const Vec2 v_half = ahead_ ? p.vel[k] : p.vel[k] + (0.5 * dt_) * p.acc[k];
+      if (dt_ * norm(v_half) / p.radius[k] > kMaxStepMotion) out.motion_id = p.id[k];
+    }
   }
   return out;
 }
@@ -225,6 +430,12 @@ void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p,
                                           std::span<const std::int32_t> sources) {
   const double h = 0.5 * dt_;
   for (const std::int32_t k : sources) {
+    if (ahead_) {  // the closing kick drifted them already
+      next_pos_[k] = p.pos[k];
+      next_vel_[k] = p.vel[k];
+      next_omega_[k] = p.omega[k];
+      continue;
+    }
     const Drifted d = kick_drift(p.pos[k], p.vel[k], p.acc[k], p.omega[k], p.alpha[k], h, dt_);
     next_pos_[k] = d.x;
     next_vel_[k] = d.v;

@@ -1,7 +1,9 @@
 // Time integrators: one type per scheme, each with a step() that names its stages.
 //
 //   VelocityVerlet       kick-drift -> walls -> rebuild or refresh -> contact forces ->
-//                        closing kick -> commit -> end-of-step round
+//                        closing kick -> commit -> end-of-step round; when nothing looks at the
+//                        state between this step and the next, the closing kick also does the
+//                        next step's kick-drift (one pass over the store instead of two)
 //   IterativeIntegrator  the thesis's scheme (T3-T8, T26-T33): walls -> rebuild? -> passes of
 //                        (predict -> refresh -> contact forces -> accelerations) until the
 //                        accelerations settle -> final predict -> commit -> end-of-step round
@@ -127,6 +129,17 @@ class Integrator {
   virtual ~Integrator() = default;
   // Advance the particles by one step of dt, ending with the step's round.
   virtual StepOutcome step(StepStages& s) = 0;
+  // Whether the step about to run may leave the store one drift ahead (Verlet: the closing kick
+  // fused with the next kick-drift): only when nothing reads or changes the particles before the
+  // next step, and never by default.
+  virtual void allow_run_ahead(bool /*allowed*/) {}
+  // The last step left the store one drift ahead (positions, velocities and spins of the next
+  // step's drift; forces cleared).
+  virtual bool ran_ahead() const { return false; }
+  // Take the drift back, to the last bits (x - dt v, ...): the state a failed step's report shows.
+  virtual void step_back(ParticleStore& /*p*/) {}
+  // The store was replaced (a backup restored): the next step starts from it as it is.
+  virtual void state_replaced() {}
   // After every rebuild (the owned set and the ghosts changed), in parallel runs.
   virtual void after_rebuild(std::size_t /*n_owned*/) {}
   // After particles were born or removed between steps and the forces evaluated anew at the
@@ -171,6 +184,29 @@ struct Drifted {
 void kick_drift_owned(ParticleStore& p, double dt, PairKinematics* mirror,
                       bool four_at_a_time = true);
 
+// Velocity Verlet's closing half kick of the owned particles, fused with the accelerations
+// (a = F/m + g, alpha = M/I, v += a dt/2, w += alpha dt/2, elastic forces cleared), and what the
+// step's round needs:
+//   checksum   sum of (a_x + a_y) + alpha + (x + y): not finite when something blew up,
+//   disp2      max |x - x_build|^2, speed2 max |v + a dt/2|^2, motion2 max |v + a dt/2|^2 / r^2,
+//   late_loss  J, the energy ledger's completion (integrators.cpp).
+// The two sums are taken in one fixed order whatever the loop: eight running sums, particle k
+// of the first 8 floor(n / 8) into sum k mod 8 and the rest into sum 0, then the eight added in
+// turn (the order of the compiler's eight-wide loop this replaced: the ledger kept its bits).
+struct ClosingKick {
+  double checksum = 0.0;
+  double disp2 = 0.0, speed2 = 0.0, motion2 = 0.0;
+  double late_loss = 0.0;
+};
+// With AVX-512 and `four_at_a_time`, four particles per iteration (the same bits).
+ClosingKick closing_kick(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                         bool four_at_a_time = true);
+// closing_kick and then the next step's kick_drift_owned in one pass over the store: the same
+// fields, the same mirror lines and the same ClosingKick, bit for bit (test_core
+// VelocityVerletRunAhead). With AVX-512 and `four_at_a_time`, four particles per iteration.
+ClosingKick closing_kick_drift(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                               PairKinematics* mirror, bool four_at_a_time = true);
+
 // Velocity Verlet (kick-drift-kick); the velocity-dependent forces see the half-step velocity.
 class VelocityVerlet final : public Integrator {
  public:
@@ -181,24 +217,24 @@ class VelocityVerlet final : public Integrator {
   void after_population_change() override {
     elastic_cleared_ = false;
     ghosts_ahead_ = false;
+    ahead_ = false;
   }
+  void allow_run_ahead(bool allowed) override { run_ahead_allowed_ = allowed; }
+  bool ran_ahead() const override { return ahead_; }
+  void step_back(ParticleStore& p) override;
+  void state_replaced() override { after_population_change(); }
 
  private:
-  struct Closing {
-    double checksum = 0.0;
-    double disp2 = 0.0, speed2 = 0.0;  // max |x - x_build|^2 and |v + a dt/2|^2 (owned)
-    double motion2 = 0.0;              // max |v + a dt/2|^2 / r^2 (owned)
-    double late_loss = 0.0;            // J, see closing_kick
-  };
-  Closing closing_kick(ParticleStore& p, const Vec2* x_build) const;
   void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
-  StepOutcome end_of_step_round(StepStages& s, const Closing& c);
+  StepOutcome end_of_step_round(StepStages& s, const ClosingKick& c);
 
   double dt_;
   Vec2 gravity_;
-  bool rebuild_next_ = true;      // decided by the previous step's round
-  bool ghosts_ahead_ = false;     // the ghosts already hold this step's drifted state
-  bool elastic_cleared_ = false;  // the owned elastic forces are zero (closing_kick)
+  bool run_ahead_allowed_ = false;  // for the step about to run (allow_run_ahead)
+  bool ahead_ = false;              // the store is one drift ahead: the next step skips its drift
+  bool rebuild_next_ = true;        // decided by the previous step's round
+  bool ghosts_ahead_ = false;       // the ghosts already hold this step's drifted state
+  bool elastic_cleared_ = false;    // the owned elastic forces are zero (closing_kick)
   // In parallel: the state the halo sources will drift to in the next step (their entries
   // only), sent to the ghosts in the end-of-step round.
   std::vector<FieldBase*> next_registry_;

@@ -236,14 +236,22 @@ void Simulation::choose_dt() {
 // One step: the integrator's stages, then its round's verdict. The backup is taken at the same
 // steps on every rank, and after every rebuild so that it holds the particles this rank owns
 // now (a rebuild may migrate them).
-void Simulation::step() {
+void Simulation::step(bool end_observed) {
   if (!baseline_taken_) take_energy_baseline();
+  // What reads the state at this step's end: the caller, the energy check, the backup, the ore
+  // models; the last step of the run (the check below, on the same figures). A step that
+  // rebuilds is backed up too: the integrator does not run ahead after a rebuild.
+  const std::int64_t next = step_ + 1;
+  const bool last = static_cast<double>(next) * dt_ + 0.5 * dt_ >= scene_.run.duration;
+  integrator_->allow_run_ahead(run_ahead_ && !end_observed && !grinding_ && !last &&
+                               next % kEnergyCheckSteps != 0 && next % kBackupSteps != 0);
   const StepOutcome outcome = integrator_->step(*this);
   ++step_;
+  steps_run_ahead_ += integrator_->ran_ahead() ? 1 : 0;
   if (outcome.unstable) report_unstable(outcome);
   if (grinding_) population_step();
   if (step_ % kEnergyCheckSteps == 0 || time_ + 0.5 * dt_ >= scene_.run.duration) check_energy();
-  if (step_ % 1000 == 0 || builds_at_backup_ != contacts_.builds()) {
+  if (step_ % kBackupSteps == 0 || builds_at_backup_ != contacts_.builds()) {
     backup_.save(particles_, time_, step_);
     builds_at_backup_ = contacts_.builds();
   }
@@ -278,7 +286,11 @@ double Simulation::local_energy() const {
 }
 
 void Simulation::run_until(double t_end) {
-  while (time_ + 0.5 * dt_ < t_end) step();
+  while (time_ + 0.5 * dt_ < t_end) {
+    // The loop's own test for the next step, on the time that step will set (advance_clock).
+    const bool more = static_cast<double>(step_ + 1) * dt_ + 0.5 * dt_ < t_end;
+    step(/*end_observed=*/!more);
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -415,7 +427,10 @@ void Simulation::report_unstable(const StepOutcome& outcome) {
   const double failed_time = time_;
   if (!finite) {
     backup_.restore(particles_, time_, step_);
+    integrator_->state_replaced();
     o << "; the last snapshot holds the last finite state (t = " << time_ << " s)";
+  } else {
+    integrator_->step_back(particles_);  // a step that ran ahead: its end state, to the last bits
   }
   throw UnstableError(o.str(), failed_step, failed_time);
 }

@@ -91,8 +91,17 @@ class Simulation final : private StepStages {
   explicit Simulation(const Scene& scene, Domain* domain = nullptr,
                       const Resumption* resume = nullptr);
 
-  void step();
+  // One step. With `end_observed` false the caller promises to read and change nothing (no
+  // particle, no output) before the next step(), so a Verlet step may leave the store one drift
+  // ahead (the closing kick fused with the next kick-drift, the same bits; integrators.hpp).
+  // The simulation itself keeps the state whole at the steps it checks or backs up.
+  void step(bool end_observed = true);
+  // Steps until t_end; the state is whole when it returns.
   void run_until(double t_end);
+  // Whether steps may run ahead at all (default on): off, every step ends whole (tests compare).
+  void set_run_ahead(bool on) { run_ahead_ = on; }
+  // Steps so far that ended one drift ahead.
+  std::int64_t steps_run_ahead() const { return steps_run_ahead_; }
 
   SeriesRow diagnostics() const;
   // The row of series.csv: diagnostics() and, with a drum, the charge's shape (collective); the
@@ -207,7 +216,10 @@ class Simulation final : private StepStages {
   double balance0_ = 0.0, motion0_ = 0.0, potential0_ = 0.0, energy_floor_ = 0.0;
   bool baseline_taken_ = false;
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
-  // Last known good state, saved every 1000 steps and after every rebuild.
+  bool run_ahead_ = true;
+  std::int64_t steps_run_ahead_ = 0;
+  // Last known good state, saved every kBackupSteps steps and after every rebuild.
+  static constexpr std::int64_t kBackupSteps = 1000;
   StateBackup backup_;
   std::int64_t builds_at_backup_ = 0;
   std::vector<GuardRecord> guards_;
