@@ -3,40 +3,22 @@
 // lines, the same bit for bit as the one-at-a-time loop, for any count (whole fours and a tail).
 #include <gtest/gtest.h>
 
-#include <cstring>
-#include <random>
-
 #include "core/integrators.hpp"
 #include "core/kinematics_mirror.hpp"
+#include "support/random_store.hpp"
 
 namespace dem2d {
 namespace {
 
-void fill_random(ParticleStore& p, std::size_t n, std::uint32_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    p.add(static_cast<std::int64_t>(k), static_cast<std::int32_t>(k % 3), 0.01 + 0.005 * u(rng),
-          7800.0, {u(rng), u(rng)}, {u(rng), u(rng)}, 10.0 * u(rng));
-    p.acc[k] = {9.81 * u(rng), 9.81 * u(rng)};
-    p.alpha[k] = 100.0 * u(rng);
-    p.theta[k] = u(rng);
-    p.force[k] = {u(rng), u(rng)};
-    p.torque[k] = u(rng);
-  }
-}
-
-template <class T>
-bool same_bits(const T& a, const T& b) {
-  return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
+using testing_support::fill_random_store;
+using testing_support::same_bits;
 
 void expect_same_drift(std::size_t n, bool mirror) {
   const auto seed = 7u + static_cast<std::uint32_t>(n);
   ParticleStore one, four, start;
-  fill_random(one, n, seed);
-  fill_random(four, n, seed);
-  fill_random(start, n, seed);
+  fill_random_store(one, n, seed);
+  fill_random_store(four, n, seed);
+  fill_random_store(start, n, seed);
   Array<PairKinematics> lines_one(n), lines_four(n);
   const double dt = 0.37;  // large: the products round visibly into the sums
   kick_drift_owned(one, dt, mirror ? lines_one.data() : nullptr, false);

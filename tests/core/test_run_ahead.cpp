@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <iostream>
 #include <random>
 #include <string>
@@ -17,35 +16,20 @@
 #include "core/kinematics_mirror.hpp"
 #include "core/simulation.hpp"
 #include "support/compare.hpp"
+#include "support/random_store.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
+
+using testing_support::fill_random_store;
+using testing_support::same_bits;
 
 using testing_support::expect_same_particles;
 using testing_support::thesis_drum_scene;
 
 // A store whose forces, elastic forces and velocities are all nonzero and unrelated, so that
 // every term of the closing kick and its sums is seen.
-void fill_random(ParticleStore& p, std::size_t n, std::uint32_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (std::size_t k = 0; k < n; ++k) {
-    p.add(static_cast<std::int64_t>(k), static_cast<std::int32_t>(k % 3), 0.01 + 0.005 * u(rng),
-          7800.0, {u(rng), u(rng)}, {u(rng), u(rng)}, 10.0 * u(rng));
-    p.acc[k] = {9.81 * u(rng), 9.81 * u(rng)};
-    p.alpha[k] = 100.0 * u(rng);
-    p.theta[k] = u(rng);
-    p.force[k] = {u(rng), u(rng)};
-    p.torque[k] = 1e-3 * u(rng);
-    p.elastic_force[k] = {0.5 * u(rng), 0.5 * u(rng)};
-  }
-}
-
-template <class T>
-bool same_bits(const T& a, const T& b) {
-  return std::memcmp(&a, &b, sizeof(T)) == 0;
-}
 
 void expect_same_closing(const ClosingKick& a, const ClosingKick& b) {
   EXPECT_TRUE(same_bits(a.checksum, b.checksum)) << a.checksum << " " << b.checksum;
@@ -60,8 +44,8 @@ void expect_same_closing(const ClosingKick& a, const ClosingKick& b) {
 void expect_same_pass(std::size_t n, bool four_at_a_time, bool mirror) {
   const auto seed = 11u + static_cast<std::uint32_t>(n);
   ParticleStore two, one;
-  fill_random(two, n, seed);
-  fill_random(one, n, seed);
+  fill_random_store(two, n, seed);
+  fill_random_store(one, n, seed);
   std::vector<Vec2> x_build(n);
   std::mt19937_64 rng(seed + 1);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -113,8 +97,8 @@ TEST(VelocityVerletRunAhead, SumsTakeTheDocumentedOrder) {
   for (std::size_t n : {5u, 8u, 29u, 1000u}) {
     for (const bool four : {false, true}) {
       ParticleStore p, q;
-      fill_random(p, n, 3u);
-      fill_random(q, n, 3u);
+      fill_random_store(p, n, 3u);
+      fill_random_store(q, n, 3u);
       std::vector<Vec2> x_build(n, Vec2{0.1, -0.2});
       const double dt = 0.37, h = 0.5 * dt;
       const Vec2 g{0.0, -9.81};
