@@ -56,6 +56,7 @@
 #include <filesystem>
 #include <fstream>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -84,6 +85,83 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+// The q-quantile of the particles' heights.
+double percentile_y(const std::vector<dem2d::Vec2>& x, double q) {
+  std::vector<double> y;
+  y.reserve(x.size());
+  for (dem2d::Vec2 p : x) y.push_back(p.y);
+  const auto k = static_cast<std::size_t>(q * static_cast<double>(y.size() - 1));
+  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
+  return y[k];
+}
+
+// The tiling of the large charges (until 2026-11-26 also bench/throughput's drums): copies of a
+// rectangular patch of a settled packing (positions x, radii r, drum radius R) cover a drum of
+// radius Rb; a copy's particle is kept if it lies inside the drum and overlaps no particle kept
+// before it by more than `allowed`; the n_target lowest kept (by y, then x) are the charge.
+struct Tiling {
+  std::vector<dem2d::Vec2> pos;
+  std::vector<double> radius;
+  double half = 0.0, y0 = 0.0, y1 = 0.0, surface = 0.0;  // the patch; the source's 99th pct. y
+  std::size_t patch = 0, candidates = 0, kept = 0;
+  int cols = 0, rows = 0;
+};
+Tiling tile(const std::vector<dem2d::Vec2>& x, const std::vector<double>& r, double R, double Rb,
+            std::int64_t n_target, double allowed) {
+  Tiling t;
+  t.surface = percentile_y(x, 0.99);
+  t.half = 0.64 * R;
+  t.y0 = -std::sqrt(R * R - t.half * t.half) + 0.02 * R;
+  t.y1 = t.surface - 0.05 * R;
+  const double w = 2.0 * t.half, h = t.y1 - t.y0;
+  std::vector<std::size_t> patch;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (std::abs(x[i].x) < t.half && x[i].y >= t.y0 && x[i].y < t.y1) patch.push_back(i);
+  const double top = t.surface * (Rb / R) + 0.1 * Rb;  // generous: trimmed to n_target below
+  t.cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
+  t.rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
+  std::vector<dem2d::Vec2> cand;
+  std::vector<double> cand_r;
+  for (int j = 0; j < t.rows; ++j)
+    for (int i = 0; i < t.cols; ++i)
+      for (std::size_t k : patch) {
+        const dem2d::Vec2 p{x[k].x + t.half - Rb + i * w, x[k].y - t.y0 - Rb + j * h};
+        if (p.y > top || dem2d::norm(p) + r[k] > Rb) continue;
+        cand.push_back(p);
+        cand_r.push_back(r[k]);
+      }
+  // Keep-first at the seams.
+  const bench::PointGrid grid(cand, 2.0 * kRadiusMax);
+  std::vector<char> kept(cand.size(), 0);
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < cand.size(); ++i) {
+    bool clash = false;
+    grid.neighbours(cand[i], [&](std::size_t u) {
+      if (!clash && kept[u] && dem2d::norm(cand[i] - cand[u]) < cand_r[i] + cand_r[u] - allowed)
+        clash = true;
+    });
+    if (!clash) {
+      kept[i] = 1;
+      order.push_back(i);
+    }
+  }
+  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
+    return cand[p].y != cand[q].y ? cand[p].y < cand[q].y : cand[p].x < cand[q].x;
+  });
+  if (static_cast<std::int64_t>(order.size()) < n_target)
+    throw std::runtime_error("partition: tiling gave only " + std::to_string(order.size()) +
+                             " particles");
+  t.patch = patch.size();
+  t.candidates = cand.size();
+  t.kept = order.size();
+  order.resize(static_cast<std::size_t>(n_target));
+  for (std::size_t i : order) {
+    t.pos.push_back(cand[i]);
+    t.radius.push_back(cand_r[i]);
+  }
+  return t;
+}
+
 struct Charge {
   std::string name;
   double drum_radius = 0.0;
@@ -99,7 +177,7 @@ Charge tile_charge(const Charge& a, std::int64_t n_target, const std::string& na
   b.name = name;
   b.drum_radius = R * scale;
   // Seams may overlap by 0.1 mm: no dynamics here, only where the particles are.
-  bench::Tiling t = bench::tile(a.x, a.r, R, b.drum_radius, n_target, 1.0e-4);
+  Tiling t = tile(a.x, a.r, R, b.drum_radius, n_target, 1.0e-4);
   b.x = std::move(t.pos);
   b.r = std::move(t.radius);
   std::printf(

@@ -49,7 +49,7 @@
 // after 4 500 steps in the turning drum), so deposited beds are measured in deposited_material()
 // (settled_scene), which costs the same per contact: the law is the same code, only two
 // coefficients differ. Before this (until 2026-11-26) the large sizes were tiled from copies of a
-// patch of the settled 30 000 packing (bench::tile, still used by bench/partition, which needs
+// patch of the settled 30 000 packing (the tiling is now bench/partition's own, which needs
 // positions only); the seams between copies left voids, and loading that bed was tried three
 // ways without success (only 0.5 contacts per particle at 1e6; the soft settle above).
 //
@@ -482,15 +482,6 @@ inline void fill_order(std::vector<dem2d::Vec2>& pos, std::vector<double>& radiu
   radius.swap(r2);
 }
 
-inline double percentile_y(const std::vector<dem2d::Vec2>& x, double q) {
-  std::vector<double> y;
-  y.reserve(x.size());
-  for (dem2d::Vec2 p : x) y.push_back(p.y);
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(y.size() - 1));
-  std::nth_element(y.begin(), y.begin() + static_cast<std::ptrdiff_t>(k), y.end());
-  return y[k];
-}
-
 // The largest overlap between any two particles of a packing.
 inline double largest_overlap(const std::vector<dem2d::Vec2>& x, const std::vector<double>& r) {
   const PointGrid grid(x, 2.0 * kRadiusMax);
@@ -500,73 +491,6 @@ inline double largest_overlap(const std::vector<dem2d::Vec2>& x, const std::vect
       if (j > i) worst = std::max(worst, r[i] + r[j] - dem2d::norm(x[i] - x[j]));
     });
   return worst;
-}
-
-// The tiling of bench/partition's large charges (until 2026-11-26 also the drum's): copies of a
-// rectangular patch of a settled packing (positions x, radii r, drum radius R) cover a drum of
-// radius Rb; a copy's particle is kept if it lies inside the drum and overlaps no particle kept
-// before it by more than `allowed`; the n_target lowest kept (by y, then x) are the charge.
-struct Tiling {
-  std::vector<dem2d::Vec2> pos;
-  std::vector<double> radius;
-  double half = 0.0, y0 = 0.0, y1 = 0.0, surface = 0.0;  // the patch; the source's 99th pct. y
-  std::size_t patch = 0, candidates = 0, kept = 0;
-  int cols = 0, rows = 0;
-};
-inline Tiling tile(const std::vector<dem2d::Vec2>& x, const std::vector<double>& r, double R,
-                   double Rb, std::int64_t n_target, double allowed) {
-  Tiling t;
-  t.surface = percentile_y(x, 0.99);
-  t.half = 0.64 * R;
-  t.y0 = -std::sqrt(R * R - t.half * t.half) + 0.02 * R;
-  t.y1 = t.surface - 0.05 * R;
-  const double w = 2.0 * t.half, h = t.y1 - t.y0;
-  std::vector<std::size_t> patch;
-  for (std::size_t i = 0; i < x.size(); ++i)
-    if (std::abs(x[i].x) < t.half && x[i].y >= t.y0 && x[i].y < t.y1) patch.push_back(i);
-  const double top = t.surface * (Rb / R) + 0.1 * Rb;  // generous: trimmed to n_target below
-  t.cols = static_cast<int>(std::ceil(2.0 * Rb / w)) + 1;
-  t.rows = static_cast<int>(std::ceil((top + Rb) / h)) + 1;
-  std::vector<dem2d::Vec2> cand;
-  std::vector<double> cand_r;
-  for (int j = 0; j < t.rows; ++j)
-    for (int i = 0; i < t.cols; ++i)
-      for (std::size_t k : patch) {
-        const dem2d::Vec2 p{x[k].x + t.half - Rb + i * w, x[k].y - t.y0 - Rb + j * h};
-        if (p.y > top || dem2d::norm(p) + r[k] > Rb) continue;
-        cand.push_back(p);
-        cand_r.push_back(r[k]);
-      }
-  // Keep-first at the seams.
-  const PointGrid grid(cand, 2.0 * kRadiusMax);
-  std::vector<char> kept(cand.size(), 0);
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < cand.size(); ++i) {
-    bool clash = false;
-    grid.neighbours(cand[i], [&](std::size_t u) {
-      if (!clash && kept[u] && dem2d::norm(cand[i] - cand[u]) < cand_r[i] + cand_r[u] - allowed)
-        clash = true;
-    });
-    if (!clash) {
-      kept[i] = 1;
-      order.push_back(i);
-    }
-  }
-  std::sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) {
-    return cand[p].y != cand[q].y ? cand[p].y < cand[q].y : cand[p].x < cand[q].x;
-  });
-  if (static_cast<std::int64_t>(order.size()) < n_target)
-    throw std::runtime_error("settled_drum: tiling gave only " + std::to_string(order.size()) +
-                             " particles");
-  t.patch = patch.size();
-  t.candidates = cand.size();
-  t.kept = order.size();
-  order.resize(static_cast<std::size_t>(n_target));
-  for (std::size_t i : order) {
-    t.pos.push_back(cand[i]);
-    t.radius.push_back(cand_r[i]);
-  }
-  return t;
 }
 
 // The deposited charge of n particles (header: N >= 300 000): radii uniform in
@@ -579,7 +503,6 @@ inline Packing deposit_packing(std::int64_t n, int choices = 4) {
   Deposition d(R, kRadiusMax);
   std::uint64_t seq = 0;
   auto uniform = [&] { return static_cast<double>(splitmix64(seq++) >> 11U) * 0x1p-53; };
-  std::int64_t rolls = 0;
   for (std::int64_t k = 0; k < n; ++k) {
     const double r = kRadiusMin + (kRadiusMax - kRadiusMin) * uniform();
     double x = 0.0, low = std::numeric_limits<double>::infinity();
@@ -595,7 +518,7 @@ inline Packing deposit_packing(std::int64_t n, int choices = 4) {
     }
     d.drop(x, r, tie);
   }
-  rolls = d.rolls();
+  const std::int64_t rolls = d.rolls();
   Packing b;
   b.pos = d.positions();
   b.radius = d.radii();
