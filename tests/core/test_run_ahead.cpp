@@ -174,12 +174,6 @@ TEST(VelocityVerletRunAhead, OnlyStepsWhoseEndNobodyReadsRunAhead) {
   expect_same_particles(whole, ahead);
 }
 
-}  // namespace
-}  // namespace dem2d
-
-namespace dem2d {
-namespace {
-
 // A step that fails after running ahead: the same message and step as the run that never runs
 // ahead, and the store stepped back to that step's end state, to the last bits (x - dt v, ...).
 // A ball is given 1.2 radii per step between two observed steps: the next step (its rebuild was
