@@ -431,7 +431,7 @@ void report(const Args& a, const std::vector<Row>& rows) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
+  dem2d::mpi::init(&argc, &argv);
   Args a;
   const bool root = rank_of(MPI_COMM_WORLD) == 0;
   if (!parse(argc, argv, a)) {

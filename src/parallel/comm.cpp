@@ -1,6 +1,13 @@
 #include "parallel/comm.hpp"
 
+#include <cstdlib>
+
 namespace dem2d::mpi {
+
+void init(int* argc, char*** argv) {
+  setenv("OMPI_MCA_io", "^ompio", /*overwrite=*/0);
+  MPI_Init(argc, argv);
+}
 
 int rank(MPI_Comm comm) {
   int r = 0;

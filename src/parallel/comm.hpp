@@ -2,7 +2,7 @@
 // parallel.c keeps all of its MPI in one file for the same reason). MpiDomain builds the
 // decomposition on these; src/io uses them for its collective decisions (row offsets of a
 // snapshot, agreeing on a failure) and takes only the MPI_Comm handle itself, which parallel
-// HDF5 needs (H5Pset_fapl_mpio); src/app calls nothing but MPI_Init, MPI_Comm_rank,
+// HDF5 needs (H5Pset_fapl_mpio); src/app calls nothing but mpi::init, MPI_Comm_rank,
 // MPI_Comm_size and MPI_Finalize (tests/structure/check_layers.sh checks both).
 //
 // Every function is collective over `comm` unless it says otherwise: all ranks call it, in
@@ -20,6 +20,16 @@
 #include <vector>
 
 namespace dem2d::mpi {
+
+// MPI_Init, after choosing the MPI-IO component that the HDF5 files are written with. Open
+// MPI's default one (OMPIO) opens every file with a shared file pointer kept under a named
+// POSIX semaphore, /dev/shm/sem.OMPIO_<file name>, locked and released inside MPI_File_open.
+// A run killed inside that window (kill -9, a batch system's time limit) leaves it locked, and
+// from then on every open of a file of that name, in any directory, waits forever. dem2d uses
+// no shared file pointer, so it leaves OMPIO out (OMPI_MCA_io=^ompio): Open MPI then uses its
+// ROMIO, which creates nothing
+// beside the file. A user's own OMPI_MCA_io is kept. Other MPI libraries ignore the variable.
+void init(int* argc, char*** argv);
 
 // Not collective: this process's rank and the number of ranks.
 int rank(MPI_Comm comm);

@@ -24,6 +24,13 @@
 #     unchanged for 5 s while it runs), a message naming the file, no crash trace, the folder
 #     released; checkpoint.h5 is whole and snapshots.h5 holds complete snapshots only; once
 #     there is room, --restart finishes the run equal to the uninterrupted one.
+#  5. What a kill -9 inside a file open leaves behind: Open MPI's default MPI-IO component
+#     (OMPIO) keeps a named semaphore per file name, /dev/shm/sem.OMPIO_<name>, that a run
+#     killed inside MPI_File_open leaves locked; every later open of that name then waits for
+#     ever. With the semaphores of checkpoint.h5.tmp and snapshots.h5 planted locked, runs on 1
+#     and 2 ranks finish (exit 0, not hung, the reference's result) and leave them untouched.
+#     A control run that asks for OMPIO (OMPI_MCA_io=ompio) shows the trap is real here: it
+#     hangs (noted, not a failure: another MPI library may have no such semaphore).
 # One line per check (ok / FAIL); exit status 1 if any failed. About 25 s of CPU time.
 set -u
 dem2d=$(realpath "$1")
@@ -34,6 +41,7 @@ seed=${DEM2D_FAULT_SEED:-4242}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 tmp=$(mktemp -d)
 disk=""     # the tmpfs mount point while one is mounted
+planted=()  # the semaphores section 5 created (removed at the end)
 started=()  # the pids of the run under way (mpirun, dem2d ranks): ended if the test is cut short
 failures=0
 pass() { echo "ok   $1"; }
@@ -54,6 +62,7 @@ cleanup() {
   local p
   for p in "${started[@]}"; do ours_alive "$p" && kill -9 "$p" 2> /dev/null; done
   if [ -n "$disk" ]; then umount "$disk" 2> /dev/null || umount -l "$disk" 2> /dev/null; fi
+  for p in "${planted[@]}"; do rm -f "/dev/shm/sem.${p#/}"; done
   grep -vE ': line [0-9]+: +[0-9]+ [A-Z][a-z]+' "$tmp/shell.err" >&3
   if [ -n "${DEM2D_KEEP_FAULT_OUTPUT:-}" ]; then echo "kept: $tmp"; else rm -rf "$tmp"; fi
 }
@@ -608,6 +617,66 @@ else
   disk_test "full disk np1 600k" 1 600k "${sparse[@]}"
   disk_test "full disk np2 700k" 2 700k "${dense[@]}"
   disk_test "full disk np2 600k" 2 600k "${sparse[@]}"
+  run_checks
+fi
+
+# ---------------------------------------------------------------------------------------------
+# 5. The semaphores of OMPIO's shared file pointer, left locked by a killed run.
+# semaphore lock|value NAME: creates the named semaphore NAME locked (value 0) or only reads
+# it; prints its value.
+semaphore() {
+  "$py" - "$1" "$2" << 'PY'
+import ctypes, os, sys
+libc = ctypes.CDLL(None, use_errno=True)
+libc.sem_open.restype = ctypes.c_void_p
+mode, name = sys.argv[1], sys.argv[2].encode()
+sem = libc.sem_open(name, os.O_CREAT, 0o644, 1) if mode == "lock" else libc.sem_open(name, 0)
+if sem in (None, ctypes.c_void_p(-1).value):
+    sys.exit(f"sem_open {sys.argv[2]}: {os.strerror(ctypes.get_errno())}")
+if mode == "lock":
+    libc.sem_trywait(ctypes.c_void_p(sem))
+value = ctypes.c_int(-1)
+libc.sem_getvalue(ctypes.c_void_p(sem), ctypes.byref(value))
+print(value.value)
+PY
+}
+semaphores_locked=1
+for name in /OMPIO_checkpoint.h5.tmp /OMPIO_snapshots.h5; do
+  [ -e "/dev/shm/sem.${name#/}" ] || planted+=("$name")
+  value=$(semaphore lock "$name" 2>&1)
+  [ "$value" = 0 ] || { semaphores_locked=0; note "cannot plant $name locked: $value"; }
+done
+if [ "$semaphores_locked" -eq 0 ]; then
+  echo "skipped: locked MPI-IO semaphores: no POSIX named semaphores here"
+else
+  for np in 1 2; do
+    name="locked semaphores np$np"
+    dir=$tmp/semaphores$np
+    start "$np" "$tmp/semaphores$np.log" "$deck" "${common[@]}" --output "$dir"
+    finish 60 "$dir"
+    if [ "$hung" -eq 1 ]; then
+      fail "$name: hung (its files unchanged for 5 s; killed)"
+      show "$tmp/semaphores$np.log"
+    elif [ "$rc" -eq 0 ]; then
+      pass "$name: exit status 0 with checkpoint.h5.tmp's and snapshots.h5's semaphores locked"
+      same_as_reference "$name" "$dir"
+    else
+      fail "$name: exit $rc, expected 0"
+      show "$tmp/semaphores$np.log"
+    fi
+  done
+  still=$(for name in /OMPIO_checkpoint.h5.tmp /OMPIO_snapshots.h5; do semaphore value "$name" 2>&1; done | tr '\n' ' ')
+  [ "$still" = "0 0 " ] && pass "locked semaphores: left as they were (values $still)" ||
+    fail "locked semaphores: the runs touched them (values $still)"
+  export OMPI_MCA_io=ompio
+  start 2 "$tmp/semaphores_ompio.log" "$deck" "${common[@]}" --output "$tmp/semaphores_ompio"
+  unset OMPI_MCA_io
+  finish 60 "$tmp/semaphores_ompio"
+  if [ "$hung" -eq 1 ]; then
+    note "control: the same run with OMPI_MCA_io=ompio hangs on the locked semaphore (killed)"
+  else
+    note "control: the same run with OMPI_MCA_io=ompio did not hang (exit $rc): no such trap here"
+  fi
   run_checks
 fi
 

@@ -1,4 +1,4 @@
-// main() of the test_io binary: GoogleTest inside MPI_Init / MPI_Finalize, so that the same
+// main() of the test_io binary: GoogleTest inside mpi::init / MPI_Finalize, so that the same
 // binary runs serially and under `mpirun -np N`. Rank 0 prints GoogleTest's usual report;
 // the other ranks print only their failures, tagged with the rank. The exit status is the
 // worst over all ranks.
@@ -6,6 +6,8 @@
 #include <mpi.h>
 
 #include <cstdio>
+
+#include "parallel/comm.hpp"
 
 namespace {
 
@@ -30,7 +32,7 @@ class RankFailurePrinter : public testing::EmptyTestEventListener {
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
+  dem2d::mpi::init(&argc, &argv);
   testing::InitGoogleTest(&argc, argv);
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
