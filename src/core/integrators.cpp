@@ -83,7 +83,46 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
 
 namespace {
 
+// The opening half kick and drift of particle k (kick_drift) and what it writes: x, v, w,
+// theta += dt w, force and torque cleared, and with `mirror` its line. kick_drift_owned's loop
+// and closing_kick_drift's both use it.
+[[gnu::always_inline]] inline void drift_one(std::size_t k, double h, double dt, Vec2* x, Vec2* v,
+                                             const Vec2* a, double* th, double* w, const double* al,
+                                             Vec2* f, double* tq, [[maybe_unused]] const double* r,
+                                             [[maybe_unused]] const double* m,
+                                             [[maybe_unused]] const std::int32_t* mat,
+                                             [[maybe_unused]] PairKinematics* mirror) {
+  const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt);
+  x[k] = d.x;
+  v[k] = d.v;
+  w[k] = d.w;
+  th[k] += dt * d.w;
+  f[k] = {};
+  tq[k] = 0.0;
 #if DEM2D_VECTOR_GATHER
+  if (mirror) store_kinematics(mirror[k], x[k], v[k], d.w, r[k], m[k], mat[k]);
+#endif
+}
+
+#if DEM2D_VECTOR_GATHER
+// What the drift of particles k..k+3 writes once their new state is in registers (x, v and w
+// of the four side by side): drift_one's stores, four at a time. drift_fours and close_four
+// both use it.
+[[gnu::always_inline]] inline void store_drift4(std::size_t k, double dt, __m512d x_new,
+                                                __m512d v_half, __m256d w_new, Vec2* x, Vec2* v,
+                                                double* th, double* w, Vec2* f, double* tq,
+                                                const double* r, const double* m,
+                                                const std::int32_t* mat, PairKinematics* mirror) {
+  _mm512_storeu_pd(&x[k].x, x_new);
+  _mm512_storeu_pd(&v[k].x, v_half);
+  _mm256_storeu_pd(w + k, w_new);
+  _mm256_storeu_pd(
+      th + k, _mm256_add_pd(_mm256_loadu_pd(th + k), _mm256_mul_pd(_mm256_set1_pd(dt), w_new)));
+  _mm512_storeu_pd(&f[k].x, _mm512_setzero_pd());
+  _mm256_storeu_pd(tq + k, _mm256_setzero_pd());
+  if (mirror) store_kinematics4(mirror + k, x_new, v_half, w_new, r + k, m + k, mat + k);
+}
+
 // Particles [0, 4 floor(n / 4)) of drift_particles, four at a time: the same multiplications and
 // additions in the same order (no FMA contraction), so the same bits; returns where it stopped.
 // The scalar loop took 37 instructions per particle (9 % of the dense block's time).
@@ -94,7 +133,7 @@ std::size_t drift_fours(std::size_t n, double h, double dt, Vec2* x, Vec2* v, co
                         [[maybe_unused]] const std::int32_t* mat,
                         [[maybe_unused]] PairKinematics* mirror) {
   const __m512d h8 = _mm512_set1_pd(h), dt8 = _mm512_set1_pd(dt);
-  const __m256d h4 = _mm256_set1_pd(h), dt4 = _mm256_set1_pd(dt);
+  const __m256d h4 = _mm256_set1_pd(h);
   std::size_t k = 0;
   for (; k + 4 <= n; k += 4) {
     // Vec2 columns: (x, y) of four particles in one register.
@@ -103,14 +142,8 @@ std::size_t drift_fours(std::size_t n, double h, double dt, Vec2* x, Vec2* v, co
     const __m512d x_new = _mm512_add_pd(_mm512_loadu_pd(&x[k].x), _mm512_mul_pd(dt8, v_half));
     const __m256d w_new =
         _mm256_add_pd(_mm256_loadu_pd(w + k), _mm256_mul_pd(h4, _mm256_loadu_pd(al + k)));
-    _mm512_storeu_pd(&x[k].x, x_new);
-    _mm512_storeu_pd(&v[k].x, v_half);
-    _mm256_storeu_pd(w + k, w_new);
-    _mm256_storeu_pd(th + k, _mm256_add_pd(_mm256_loadu_pd(th + k), _mm256_mul_pd(dt4, w_new)));
-    _mm512_storeu_pd(&f[k].x, _mm512_setzero_pd());
-    _mm256_storeu_pd(tq + k, _mm256_setzero_pd());
-    if constexpr (kMirror)
-      store_kinematics4(mirror + k, x_new, v_half, w_new, r + k, m + k, mat + k);
+    store_drift4(k, dt, x_new, v_half, w_new, x, v, th, w, f, tq, r, m, mat,
+                 kMirror ? mirror : nullptr);
   }
   return k;
 }
@@ -129,18 +162,8 @@ void drift_particles(std::size_t n, double h, double dt, Vec2* x, Vec2* v, const
 #if DEM2D_VECTOR_GATHER
   if (fours) from = drift_fours<kMirror>(n, h, dt, x, v, a, th, w, al, f, tq, r, m, mat, mirror);
 #endif
-  for (std::size_t k = from; k < n; ++k) {
-    const Drifted d = kick_drift(x[k], v[k], a[k], w[k], al[k], h, dt);
-    x[k] = d.x;
-    v[k] = d.v;
-    w[k] = d.w;
-    th[k] += dt * d.w;
-    f[k] = {};
-    tq[k] = 0.0;
-#if DEM2D_VECTOR_GATHER
-    if constexpr (kMirror) store_kinematics(mirror[k], x[k], v[k], d.w, r[k], m[k], mat[k]);
-#endif
-  }
+  for (std::size_t k = from; k < n; ++k)
+    drift_one(k, h, dt, x, v, a, th, w, al, f, tq, r, m, mat, kMirror ? mirror : nullptr);
 }
 
 }  // namespace
@@ -232,21 +255,6 @@ ClosingColumns closing_columns(ParticleStore& p, const Vec2* x_build, PairKinema
   sums.motion2 = sums.motion2 > m2 ? sums.motion2 : m2;
 }
 
-// The next step's kick-drift of particle k, after close_one (kick_drift, as kick_drift_owned).
-[[gnu::always_inline]] inline void drift_one(std::size_t k, double h, double dt,
-                                             const ClosingColumns& c) {
-  const Drifted d = kick_drift(c.x[k], c.v[k], c.a[k], c.w[k], c.al[k], h, dt);
-  c.x[k] = d.x;
-  c.v[k] = d.v;
-  c.w[k] = d.w;
-  c.th[k] += dt * d.w;
-  c.f[k] = {};
-  c.tq[k] = 0.0;
-#if DEM2D_VECTOR_GATHER
-  if (c.mirror) store_kinematics(c.mirror[k], c.x[k], c.v[k], d.w, c.r[k], c.m[k], c.mat[k]);
-#endif
-}
-
 std::size_t sum_lane(std::size_t k, std::size_t whole) { return k < whole ? k % kSumLanes : 0; }
 
 #if DEM2D_VECTOR_GATHER
@@ -306,15 +314,8 @@ template <bool kDrift>
     return;
   }
   const __m512d X_new = _mm512_add_pd(X, _mm512_mul_pd(_mm512_set1_pd(dt), V_half));
-  const __m256d W_half = _mm256_add_pd(W, hAL);
-  _mm512_storeu_pd(&c.x[k].x, X_new);
-  _mm512_storeu_pd(&c.v[k].x, V_half);
-  _mm256_storeu_pd(c.w + k, W_half);
-  _mm256_storeu_pd(c.th + k, _mm256_add_pd(_mm256_loadu_pd(c.th + k),
-                                           _mm256_mul_pd(_mm256_set1_pd(dt), W_half)));
-  _mm512_storeu_pd(&c.f[k].x, _mm512_setzero_pd());
-  _mm256_storeu_pd(c.tq + k, _mm256_setzero_pd());
-  if (c.mirror) store_kinematics4(c.mirror + k, X_new, V_half, W_half, c.r + k, c.m + k, c.mat + k);
+  store_drift4(k, dt, X_new, V_half, _mm256_add_pd(W, hAL), c.x, c.v, c.th, c.w, c.f, c.tq, c.r,
+               c.m, c.mat, c.mirror);
 }
 
 // close_four over particles [0, 8 floor(n / 8)), eight per iteration (the sums' lanes 0-3 and
@@ -361,7 +362,8 @@ ClosingKick close(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity
 #endif
   for (std::size_t k = from; k < n; ++k) {
     close_one(k, sum_lane(k, whole), h, gravity, c, sums);
-    if constexpr (kDrift) drift_one(k, h, dt, c);
+    if constexpr (kDrift)
+      drift_one(k, h, dt, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
   }
   return sums.result(dt);
 }
