@@ -321,16 +321,25 @@ class RunLoop {
     last_snapshot_time_ = sim_.time();
     if (sim_.spectra()) write_collisions(MPI_COMM_WORLD, scene_.output.directory, *sim_.spectra());
   }
+  // The outputs due at time t: one test for the step that acts on them (after_step, finish)
+  // and for the one that predicts them (observes_next_step).
+  struct Due {
+    bool series, snapshot, checkpoint;
+    bool any() const { return series || snapshot || checkpoint; }
+  };
+  Due due_at(double t) const {
+    const OutputSpec& out = scene_.output;
+    return {at_multiple(t, out.series_interval), at_multiple(t, out.snapshot_interval),
+            at_multiple(t, out.checkpoint_interval)};
+  }
+  static bool polls_at(std::int64_t step) { return step % kStopPollSteps == 0; }
   void after_step();
   // Whether anything reads the particles after the coming step: an output or checkpoint due at
   // its time, the stop poll, the end of the run (else the step may run ahead: Simulation::step).
   bool observes_next_step() const {
-    const OutputSpec& out = scene_.output;
     const std::int64_t next = sim_.step_count() + 1;
-    const double t = static_cast<double>(next) * sim_.dt();
-    return next % kStopPollSteps == 0 || t + 0.5 * sim_.dt() >= scene_.run.duration ||
-           at_multiple(t, out.series_interval) || at_multiple(t, out.snapshot_interval) ||
-           at_multiple(t, out.checkpoint_interval);
+    const double t = static_cast<double>(next) * sim_.dt();  // Simulation::advance_clock's
+    return polls_at(next) || t + 0.5 * sim_.dt() >= scene_.run.duration || due_at(t).any();
   }
   // The logs' records up to now first: a restart keeps the rows up to the checkpoint's time.
   void checkpoint() {
@@ -368,8 +377,7 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
     while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
       sim_.step(observes_next_step());
       after_step();
-      if (sim_.step_count() % kStopPollSteps == 0 && stop_requested())
-        return finish(Ending::kInterrupted);
+      if (polls_at(sim_.step_count()) && stop_requested()) return finish(Ending::kInterrupted);
       progress.update(sim_, n_global);
     }
   } catch (const UnstableError& e) {
@@ -385,18 +393,18 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
 }
 
 void RunLoop::after_step() {
-  const OutputSpec& out = scene_.output;
   for (; guards_told_ < sim_.guard_records().size(); ++guards_told_)
     say(scene_.deck_path + ": warning: " + sim_.guard_records()[guards_told_].first +
             " (run.guards = \"warn\": the run goes on)\n",
         stderr);
-  if (at_multiple(sim_.time(), out.series_interval)) {
+  const Due due = due_at(sim_.time());
+  if (due.series) {
     series_.write(sim_.record_row());
     ore_.write(sim_);
     sim_.reset_pass_window();
   }
-  if (at_multiple(sim_.time(), out.snapshot_interval)) snapshot();
-  if (at_multiple(sim_.time(), out.checkpoint_interval)) checkpoint();
+  if (due.snapshot) snapshot();
+  if (due.checkpoint) checkpoint();
 }
 
 bool RunLoop::stop_requested() {
@@ -415,10 +423,8 @@ bool RunLoop::stop_requested() {
 // interrupted: the restart writes the rows from here on, as the whole run would have), the
 // logs, and the checkpoint, always.
 Ending RunLoop::finish(Ending ending) {
-  const OutputSpec& out = scene_.output;
   if (last_snapshot_time_ != sim_.time()) snapshot();
-  if (ending == Ending::kFinished && !at_multiple(sim_.time(), out.series_interval))
-    series_.write(sim_.record_row());
+  if (ending == Ending::kFinished && !due_at(sim_.time()).series) series_.write(sim_.record_row());
   if (checkpoint_step_ != sim_.step_count()) checkpoint();
   return ending;
 }
