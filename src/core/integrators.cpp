@@ -238,6 +238,12 @@ ClosingColumns closing_columns(ParticleStore& p, const Vec2* x_build, PairKinema
           mirror};
 }
 
+// The running maximum: `most` unless `next` is larger (or `most` is NaN; not std::max, which
+// keeps `most` then). Scalar here, four lanes below.
+[[gnu::always_inline]] inline double keep_larger(double most, double next) {
+  return most > next ? most : next;
+}
+
 // The closing half kick of particle k, its share of the sums in `lane`.
 [[gnu::always_inline]] inline void close_one(std::size_t k, std::size_t lane, double h, Vec2 g,
                                              const ClosingColumns& c, ClosingSums& sums) {
@@ -250,9 +256,9 @@ ClosingColumns closing_columns(ParticleStore& p, const Vec2* x_build, PairKinema
   const double d2 = norm2(c.x[k] - c.x_build[k]);
   const double s2 = norm2(c.v[k] + h * c.a[k]);
   const double m2 = s2 / (c.r[k] * c.r[k]);
-  sums.disp2 = sums.disp2 > d2 ? sums.disp2 : d2;
-  sums.speed2 = sums.speed2 > s2 ? sums.speed2 : s2;
-  sums.motion2 = sums.motion2 > m2 ? sums.motion2 : m2;
+  sums.disp2 = keep_larger(sums.disp2, d2);
+  sums.speed2 = keep_larger(sums.speed2, s2);
+  sums.motion2 = keep_larger(sums.motion2, m2);
 }
 
 std::size_t sum_lane(std::size_t k, std::size_t whole) { return k < whole ? k % kSumLanes : 0; }
@@ -269,7 +275,7 @@ std::size_t sum_lane(std::size_t k, std::size_t whole) { return k < whole ? k % 
   const __m512i pairs = _mm512_setr_epi64(0, 0, 1, 1, 2, 2, 3, 3);
   return _mm512_permutexvar_pd(pairs, _mm512_zextpd256_pd512(_mm256_loadu_pd(q)));
 }
-// `most > next ? most : next` of close_one, four lanes at once.
+// keep_larger, four lanes at once.
 [[gnu::always_inline]] inline __m256d keep_larger(__m256d most, __m256d next) {
   return _mm256_blendv_pd(next, most, _mm256_cmp_pd(most, next, _CMP_GT_OQ));
 }
@@ -340,9 +346,9 @@ std::size_t close_fours(std::size_t n, double h, double dt, Vec2 g, const Closin
   _mm256_store_pd(lanes[1], most.speed2);
   _mm256_store_pd(lanes[2], most.motion2);
   for (std::size_t l = 0; l < 4; ++l) {
-    sums.disp2 = sums.disp2 > lanes[0][l] ? sums.disp2 : lanes[0][l];
-    sums.speed2 = sums.speed2 > lanes[1][l] ? sums.speed2 : lanes[1][l];
-    sums.motion2 = sums.motion2 > lanes[2][l] ? sums.motion2 : lanes[2][l];
+    sums.disp2 = keep_larger(sums.disp2, lanes[0][l]);
+    sums.speed2 = keep_larger(sums.speed2, lanes[1][l]);
+    sums.motion2 = keep_larger(sums.motion2, lanes[2][l]);
   }
   return whole;
 }
