@@ -55,6 +55,9 @@ class ContactKernel {
   // The last evaluation's histories were committed / the lists were rebuilt or replaced.
   virtual void committed() = 0;
   virtual void lists_changed() = 0;
+  // Whether evaluate writes the pairs' new histories over the committed ones instead of into
+  // the trial slots (then the commit has nothing to swap; the same values either way).
+  virtual bool histories_in_place() const { return false; }
   // The pair gather's mirror lines of the owned particles, for the drift about to run to write
   // (core/kinematics_mirror.hpp); nullptr when this kernel keeps no mirror.
   virtual PairKinematics* drift_mirror(const ParticleStore&) { return nullptr; }
@@ -78,6 +81,8 @@ class ContactEngine {
   // Forces of every listed contact for the current state; histories advanced by dt into the
   // trial slots (dt = 0: at rest in time). The force accumulators are added to, not cleared.
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
+  // See ContactKernel::histories_in_place.
+  bool histories_in_place() const { return kernel_->histories_in_place(); }
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
   const EvaluationTotals& totals() const { return totals_; }

@@ -100,6 +100,7 @@ class Kernel final : public ContactKernel {
     live_walls_.swap(next_live_walls_);
   }
   void lists_changed() override { rescan_ = true; }
+  bool histories_in_place() const override { return kInPlace; }
   PairKinematics* drift_mirror(const ParticleStore& p) override {
 #if DEM2D_VECTOR_GATHER
     if (vector_gather_) {
@@ -172,6 +173,13 @@ class Kernel final : public ContactKernel {
   // law): with a Hertz stiffness what a contact holds in its last step vanishes with dt (nil to
   // 4 digits in the waterfall's balance), and tracking it cost 3-6 % of the run time.
   static constexpr bool kTrackRelease = kSpringSlots > 0 && !Model::Law::kStiffnessVanishes;
+  // The pairs' new histories written over the committed ones (ContactKernel::histories_in_place)
+  // where nothing reads the committed ones after the evaluation: not with release tracking
+  // (release_ended), a tracker (the collision spectra read both) or the iterative scheme (its
+  // passes all start from the committed histories).
+  static constexpr bool kInPlace = !kTrackRelease &&
+                                   std::is_same_v<typename Model::Tracker, TrackNone> &&
+                                   std::is_same_v<typename Model::Stepper, StepAsSeen>;
   double released_ = 0.0;
   // The list entries in contact in the committed histories (the only ones that can end in this
   // step), and those in contact in this evaluation (committed next). After a rebuild they are
@@ -319,8 +327,9 @@ void Kernel<Model>::release_ended(const ParticleStore& p, const Walls& walls, co
 template <class Model>
 std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
                                         std::size_t k1) {
-  std::fill(pl.trial.data() + k0 * W, pl.trial.data() + k1 * W, 0.0);  // the scatter rewrites
-  std::array<double*, W + 1> old{};                                    // W may be 0
+  if constexpr (!kInPlace)  // the scatter rewrites the contacts'
+    std::fill(pl.trial.data() + k0 * W, pl.trial.data() + k1 * W, 0.0);
+  std::array<double*, W + 1> old{};  // W may be 0
   for (std::size_t s = 0; s < W; ++s) old[s] = b_.history.old[s].data();
   const GatherColumns cols{.x = p.pos.data(),
                            .v = p.vel.data(),
@@ -362,8 +371,10 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
     std::fill(touch + k0, touch + k1, std::uint8_t{0});
     for (std::size_t c = 0; c < n; ++c) touch[b_.pair[c]] = 1;
   }
+  if (!vector_gather_ && n > 0) gather_inputs_scalar(cols, 0, n);
+  // In place: the committed histories of the chunk are read; the scatter rewrites the contacts'.
+  if constexpr (kInPlace) std::fill(pl.history.data() + k0 * W, pl.history.data() + k1 * W, 0.0);
   if (n == 0) return 0;
-  if (!vector_gather_) gather_inputs_scalar(cols, 0, n);
   // Padding lanes repeat the last contact.
   for (std::size_t c = n; c < padded(n); ++c) {
     b_.copy(c, n - 1);
@@ -438,7 +449,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
-  double* trial = pl.trial.data();
+  double* trial = kInPlace ? pl.history.data() : pl.trial.data();
   const std::int32_t* bj = bj_.data();
   // The partner's three lines kAhead contacts ahead (the lower-id particles come in order), where
   // the store is past the caches: at 1e5 particles the scatter waited on them (whole run 0.94x
@@ -469,7 +480,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
 
 template <class Model>
 void Kernel<Model>::write_records(PairList& pl, std::size_t n) {
-  double* trial = pl.trial.data();
+  double* trial = kInPlace ? pl.history.data() : pl.trial.data();
   ForceRecord* rec = records_.data();
   for (std::size_t c = 0; c < n; ++c) {
     const std::size_t k = static_cast<std::size_t>(b_.pair[c]);

@@ -269,7 +269,7 @@ void NeighborSearch::build_particle_pairs(const ParticleStore& p, double skin, P
       },
       fresh.history);
   if (!id_ordered_) to_storage_order(n, p.n_owned(), fresh);
-  fresh.trial = fresh.history;
+  if (pair_trials_) fresh.trial = fresh.history;
   out = std::move(fresh);
 }
 

@@ -68,6 +68,9 @@ class NeighborSearch {
       const ParticleStore& p, double cutoff_extra);
 
   std::int64_t builds() const { return builds_; }
+  // Whether the pair list gets trial slots (a copy of its histories; default yes): a kernel that
+  // writes the histories in place needs none (ContactKernel::histories_in_place).
+  void set_pair_trials(bool on) { pair_trials_ = on; }
   // Size levels (bin_particles): as their expected work says (default), always, or never (one
   // grid sized by the largest particle). Tests and benchmarks set it; the lists are the same.
   enum class Levels { kAuto, kAlways, kNever };
@@ -106,6 +109,7 @@ class NeighborSearch {
   std::uint64_t layout_ = ~std::uint64_t{0};
   bool id_ordered_ = true;  // the owned particles are in id order
   Levels levels_mode_ = Levels::kAuto;
+  bool pair_trials_ = true;
   std::int64_t builds_ = 0;
   double far_fraction_ = 0.0;
 };

@@ -20,6 +20,9 @@
 #include "core/materials.hpp"
 #include "core/scene.hpp"
 #include "core/simulation.hpp"
+#include "support/compare.hpp"
+#include "support/random_store.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
@@ -943,6 +946,47 @@ TEST(ModelSlots, TheTrackerChangesNoParticleState) {
     EXPECT_EQ(tracked.particles().pos[k], plain.particles().pos[k]);
     EXPECT_EQ(tracked.particles().vel[k], plain.particles().vel[k]);
     EXPECT_EQ(tracked.particles().omega[k], plain.particles().omega[k]);
+  }
+}
+
+// Where nothing reads the committed histories after an evaluation (no tracker, no release
+// tracking, velocity Verlet) the kernel writes the new ones over them, instead of into trial
+// slots swapped in at the commit (ContactKernel::histories_in_place). Both must give the same
+// values: a frictional drum with rolling resistance, untracked (in place) against tracked
+// (double-buffered; the tracker's slot comes last and changes no force), every particle and
+// every listed contact's springs bit for bit.
+TEST(ModelSlots, HistoriesWrittenInPlaceAreTheDoubleBufferedOnes) {
+  const auto scene = [](bool tracked) {
+    Scene s = testing_support::thesis_drum_scene(120, 1.8, 16, 0.1);
+    s.contact.model = ContactModelKind::kHertzMindlin;
+    s.contact.rolling = RollingModelKind::kEpsd;
+    s.contact.track_peak_energy = tracked;
+    return s;
+  };
+  Simulation plain(scene(false)), tracked(scene(true));
+  ASSERT_TRUE(plain.contacts().histories_in_place());
+  ASSERT_FALSE(tracked.contacts().histories_in_place());
+  for (const double t : {0.3, 0.5}) {  // the charge has landed
+    plain.run_until(t);
+    tracked.run_until(t);
+    SCOPED_TRACE(testing::Message() << "t = " << t);
+    testing_support::expect_same_particles(plain, tracked);
+    const PairList& a = plain.pairs();
+    const PairList& b = tracked.pairs();
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t springs = 0, differ = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      ASSERT_EQ(a.id_i[k], b.id_i[k]);
+      ASSERT_EQ(a.id_j[k], b.id_j[k]);
+      for (std::size_t s = 0; s < 2; ++s) {
+        springs += a.history_of(k)[s] != 0.0;
+        differ += !testing_support::same_bits(a.history_of(k)[s], b.history_of(k)[s]);
+      }
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(springs, 50u) << "the charge should hold loaded springs";
+    std::cout << "[ springs ] t = " << t << ": " << springs << " nonzero of " << 2 * a.size()
+              << "\n";
   }
 }
 
