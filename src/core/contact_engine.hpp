@@ -79,7 +79,8 @@ class ContactEngine {
   // current pose, within `skin`; histories of contacts still listed are kept.
   void build(const ParticleStore& p, const Walls& walls, double skin);
   // Forces of every listed contact for the current state; histories advanced by dt into the
-  // trial slots (dt = 0: at rest in time). The force accumulators are added to, not cleared.
+  // trial slots, or over the committed ones (histories_in_place) (dt = 0: at rest in time). The
+  // force accumulators are added to, not cleared.
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
   // See ContactKernel::histories_in_place.
   bool histories_in_place() const { return kernel_->histories_in_place(); }

@@ -27,7 +27,7 @@ struct PairList {
   Array<std::int64_t> id_i, id_j;  // keys, id_i < id_j
   std::size_t width = 0;           // history values per contact
   Array<double> history;  // committed at the end of each step: [k * width, (k + 1) * width)
-  Array<double> trial;    // written by each force evaluation
+  Array<double> trial;    // written by each force evaluation (empty when it writes in place)
   // Storage order (core/spatial_order.hpp). When the owned particles are not in id order, the
   // entries are kept in the order of their lower local index, so that a sweep over the list
   // walks the particle data in memory order. key_order[t] is then the entry of the t-th key in

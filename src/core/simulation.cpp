@@ -390,7 +390,7 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
 }
 
 void Simulation::commit(double dt, double late_loss) {
-  if (spectra_) {
+  if (spectra_) {  // the spectra's tracker keeps the trial slots (Kernel::kInPlace)
     const PairList& pl = contacts_.pairs();
     const WallPairList& wl = contacts_.wall_pairs();
     spectra_->book_ended(particles_, walls_, pl.history.data(), pl.trial.data(),
