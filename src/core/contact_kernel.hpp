@@ -154,6 +154,11 @@ class Kernel final : public ContactKernel {
   void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
   void write_records(PairList& pl, std::size_t n);
+  // Where the scatter writes the contacts' new histories: over the committed ones (kInPlace) or
+  // into the trial slots.
+  static double* new_histories(PairList& pl) {
+    return kInPlace ? pl.history.data() : pl.trial.data();
+  }
   void sum_records(ParticleStore& p, const PairList& pl);
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                      EvaluationTotals& tot);
@@ -449,7 +454,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
-  double* trial = kInPlace ? pl.history.data() : pl.trial.data();
+  double* trial = new_histories(pl);
   const std::int32_t* bj = bj_.data();
   // The partner's three lines kAhead contacts ahead (the lower-id particles come in order), where
   // the store is past the caches: at 1e5 particles the scatter waited on them (whole run 0.94x
@@ -480,7 +485,7 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
 
 template <class Model>
 void Kernel<Model>::write_records(PairList& pl, std::size_t n) {
-  double* trial = kInPlace ? pl.history.data() : pl.trial.data();
+  double* trial = new_histories(pl);
   ForceRecord* rec = records_.data();
   for (std::size_t c = 0; c < n; ++c) {
     const std::size_t k = static_cast<std::size_t>(b_.pair[c]);
