@@ -4,7 +4,8 @@
 
     bench/size_rounds.py [--throughput build/bench/throughput] [--sizes 10000,30000,100000,1000000]
                          [--rounds 5] [--cpu 0] [--against OTHER_THROUGHPUT]
-                         [--label NAME] [--results bench/results] [--csv size_rounds.csv]
+                         [--label NAME] [--against-label NAME] [--results bench/results]
+                         [--csv size_rounds.csv]
 
 This machine's speed moves by up to 1.4x over minutes, so one long `throughput` run that walks
 the sizes in turn can put 1e4 in a fast phase and 1e6 in a slow one. Here each size runs as its
@@ -73,7 +74,8 @@ def parse_args():
     a.add_argument("--rounds", type=int, default=5)
     a.add_argument("--cpu", type=int, default=0, help="core to pin to (-1: none)")
     a.add_argument("--against", help="a second throughput binary, run in pairs with the first")
-    a.add_argument("--label", default="this")
+    a.add_argument("--label", default="this", help="this binary's name in the CSV")
+    a.add_argument("--against-label", default="against", help="the other binary's name")
     a.add_argument("--results", default=os.path.join(HERE, "results"))
     a.add_argument("--csv", default="size_rounds.csv")
     args = a.parse_args()
@@ -84,6 +86,8 @@ def parse_args():
                 "10000,100000")
     if not args.sizes or min(args.sizes) < 1000 or args.rounds < 1:
         a.error("--sizes: counts of at least 1000; --rounds: at least 1")
+    if args.against and args.against_label == args.label:
+        a.error("--label and --against-label must differ")
     for b in [args.throughput] + ([args.against] if args.against else []):
         if not os.access(b, os.X_OK):
             a.error(f"{b}: not an executable throughput binary (build it: scripts/build)")
@@ -95,7 +99,7 @@ def measure(args):
     cpu = None if args.cpu < 0 else args.cpu
     binaries = [(args.label, args.throughput)]
     if args.against:
-        binaries.append(("against", args.against))
+        binaries.append((args.against_label, args.against))
     rows = []
     for rnd in range(1, args.rounds + 1):
         first = {}
@@ -124,7 +128,7 @@ def report(args, rows):
         line = f"{n:<12} {min(ns):7.2f}-{max(ns):<7.2f}         {spread(over)}"
         if args.against:
             other = {r["round"]: float(r["ns_per_particle_step_cpu"]) for r in rows
-                     if r["label"] == "against" and r["n_particles"] == n}
+                     if r["label"] == args.against_label and r["n_particles"] == n}
             line += "    " + spread([float(r["ns_per_particle_step_cpu"]) / other[r["round"]]
                                      for r in mine])
         if n != args.sizes[0] and statistics.median(over) > BOUND:
@@ -134,7 +138,7 @@ def report(args, rows):
 
 def plot(args, rows, path):
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for label, marker in ((args.label, "o"), ("against", "s")):
+    for label, marker in ((args.label, "o"), (args.against_label, "s")):
         mine = [r for r in rows if r["label"] == label]
         if not mine:
             continue
