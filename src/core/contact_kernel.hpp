@@ -58,6 +58,10 @@ template <class Model>
 
 inline std::size_t padded(std::size_t n) { return (n + kPackSize - 1) / kPackSize * kPackSize; }
 
+// From this many particles (owned and ghosts) the canonical scatter fetches its partners' lines
+// ahead (Kernel::scatter_pairs).
+inline constexpr std::size_t kScatterPrefetchFrom = 50000;
+
 // The force loop for one contact model (style.md item 4: written once, the model chosen at
 // setup). Particle-particle contacts in canonical (lower id first, sorted) order, in chunks,
 // then particle-wall contacts; each in the three phases of contact_batch.hpp. Both paths call
@@ -459,8 +463,8 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
   // The partner's three lines kAhead contacts ahead (the lower-id particles come in order), where
   // the store is past the caches: at 1e5 particles the scatter waited on them (whole run 0.94x
   // with the prefetch), at 3e4 the prefetch cost 4 % (bench/throughput, paired runs).
-  constexpr std::size_t kAhead = 16, kPrefetchFrom = 50000;
-  const std::size_t ahead = p.size() >= kPrefetchFrom ? kAhead : n;
+  constexpr std::size_t kAhead = 16;
+  const std::size_t ahead = p.size() >= kScatterPrefetchFrom ? kAhead : n;
   for (std::size_t c = 0; c < n; ++c) {
     if (c + ahead < n) {
       const std::int32_t next = bj[c + ahead];

@@ -12,6 +12,7 @@
 #include <random>
 #include <set>
 
+#include "core/contact_kernel.hpp"
 #include "core/simulation.hpp"
 #include "core/spatial_order.hpp"
 #include "support/compare.hpp"
@@ -102,9 +103,9 @@ TEST(SpatialOrder, SortingChangesNoBitWhileOreBreaksIsFedAndSieved) {
                                  });
 }
 
-// Past the caches: from 50 000 particles on, the canonical scatter of a store in id order fetches
-// its partners' lines ahead (Kernel::scatter_pairs), which the smaller scenes above never do; a
-// sorted store sums force records instead. A square lattice of 52 900 balls of 4 mm, each
+// Past the caches: from kernels::kScatterPrefetchFrom (50 000) particles on, the canonical scatter
+// of a store in id order fetches its partners' lines ahead, which the smaller scenes above never
+// do; a sorted store sums force records instead. A square lattice of 52 900 balls of 4 mm, each
 // touching its four neighbours and pushed at random, run both ways for 40 steps: every field of
 // every particle bit for bit (under the sanitizers too: the lines fetched ahead stay in the list).
 TEST(SpatialOrder, SortingChangesNoBitOfAChargePastTheCaches) {
@@ -128,7 +129,7 @@ TEST(SpatialOrder, SortingChangesNoBitOfAChargePastTheCaches) {
   Simulation plain(s);
   s.run.spatial_sort = SpatialSort::kAlways;
   Simulation sorted(s);
-  ASSERT_GE(plain.particles().size(), 50000u);
+  ASSERT_GE(plain.particles().size(), kernels::kScatterPrefetchFrom);
   for (int k = 0; k < 40; ++k) {
     plain.step();
     sorted.step();
