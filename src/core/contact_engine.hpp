@@ -61,6 +61,9 @@ class ContactKernel {
   // The pair gather's mirror lines of the owned particles, for the drift about to run to write
   // (core/kinematics_mirror.hpp); nullptr when this kernel keeps no mirror.
   virtual PairKinematics* drift_mirror(const ParticleStore&) { return nullptr; }
+  // With the breakage tracker: the pair-list entries of the last evaluation whose breakage test
+  // is due (TrackBreakage::test_due of their new histories), in list order. Empty otherwise.
+  virtual std::span<const std::int32_t> breakage_tests_due() const { return {}; }
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.
@@ -86,6 +89,8 @@ class ContactEngine {
   bool histories_in_place() const { return kernel_->histories_in_place(); }
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
+  // See ContactKernel::breakage_tests_due.
+  std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }
   // The trial histories become the committed ones.
   void commit();

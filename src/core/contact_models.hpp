@@ -517,6 +517,11 @@ struct TrackBreakage {
     h[kEnergy] = cf.strain;
     h[kTested] = old[kTested];
   }
+  // A contact past its peak, the peak above the level already tested: its breakage test is due
+  // (core/grinding.hpp).
+  static bool test_due(double peak, double energy, double tested) {
+    return energy < peak && peak > tested;
+  }
 };
 
 // ---------------------------------------------------------------------------------------------

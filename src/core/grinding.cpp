@@ -57,7 +57,7 @@ Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& dom
 }
 
 bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
-                          Domain& domain) {
+                          Domain& domain, const std::function<void()>& before_change) {
   std::vector<Broken> broken;
   if (break_material_ >= 0) {
     std::vector<Test> tests;
@@ -70,6 +70,7 @@ bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, Cont
   const std::int64_t changes =
       domain.sum(static_cast<std::int64_t>(broken.size()) + sieved);  // one collective per step
   if (changes != 0) {
+    before_change();
     births_from_ = next_id_;
     // The parents as they were, then the store without them and without the product.
     std::vector<Parent> parents;
@@ -87,7 +88,10 @@ bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, Cont
     totals_.discharged_mass += domain.sum(sieved_mass);
   }
   if (!feed_due(time)) return changes != 0;
-  if (changes == 0) births_from_ = next_id_;
+  if (changes == 0) {
+    before_change();
+    births_from_ = next_id_;
+  }
   const bool fed = feed(time, p, domain);
   return changes != 0 || fed;
 }
@@ -103,14 +107,16 @@ void Grinding::collect_tests(const ParticleStore& p, ContactEngine& contacts,
     return static_cast<std::size_t>(i) < n_owned && p.material[i] == break_material_ &&
            p.radius[i] >= r_min;
   };
-  const auto due = [&](double* h) {
-    const double peak = h[TrackBreakage::kPeak];
-    return h[TrackBreakage::kEnergy] < peak && peak > h[TrackBreakage::kTested];
+  const auto due = [&](const double* h) {
+    return TrackBreakage::test_due(h[TrackBreakage::kPeak], h[TrackBreakage::kEnergy],
+                                   h[TrackBreakage::kTested]);
   };
+  // The pairs: those the evaluation found due (the only ones: a listed pair not in contact has
+  // a zero history), in list order.
   PairList& pl = contacts.mutable_pairs();
-  for (std::size_t k = 0; k < pl.size(); ++k) {
+  for (const std::int32_t entry : contacts.breakage_tests_due()) {
+    const auto k = static_cast<std::size_t>(entry);
     double* h = pl.history.data() + k * pl.width + off;
-    if (!due(h)) continue;
     const std::int32_t i = pl.i[k], j = pl.j[k];
     const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
     if (breakable(i)) out.push_back({pl.id_i[k], pl.id_j[k], std::size_t(i), peak, tested});

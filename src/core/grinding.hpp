@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/contact_engine.hpp"
@@ -74,9 +75,10 @@ class Grinding {
 
   // After a committed step at `time`: tests, breaks, sieve and feed (collective). Returns true,
   // on every rank alike, when the population changed; the caller then rebuilds and calls
-  // exclude_births().
+  // exclude_births(). `before_change` is called just before the store first changes (on every
+  // rank alike; not at all in a step that changes nothing).
   bool after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
-                  Domain& domain);
+                  Domain& domain, const std::function<void()>& before_change);
   // After the rebuild that follows a change: every listed contact of a particle born in it is
   // excluded (the next evaluation keeps the overlapping ones).
   void exclude_births(ContactEngine& contacts) const;

@@ -258,9 +258,12 @@ void Simulation::step(bool end_observed) {
 }
 
 void Simulation::population_step() {
-  const double before = local_energy();
+  // The energy before the change, taken only in a step that changes the store (most do not).
+  double before = 0.0;
   const double fed = grinding_->fed_energy(), discharged = grinding_->discharged_energy();
-  if (!grinding_->after_step(time_, step_, particles_, contacts_, *domain_)) return;
+  if (!grinding_->after_step(time_, step_, particles_, contacts_, *domain_,
+                             [&] { before = local_energy(); }))
+    return;
   domain_->population_changed(domain_->sum(static_cast<std::int64_t>(particles_.n_owned())));
   rebuild();
   grinding_->exclude_births(contacts_);

@@ -8,6 +8,7 @@
 #include <map>
 #include <numbers>
 
+#include "core/contact_models.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
 
@@ -400,6 +401,30 @@ TEST(Grinding, FeedByMassRateAtAPointKeepsUpAndWaitsForRoom) {
   const GrindingTotals& g = sim.grinding()->totals();
   EXPECT_GE(g.fed_count, 3);
   EXPECT_LT(g.fed_mass, 200.0 * 0.3);  // it waited for room
+}
+
+// The force loop hands the grinding the pairs whose breakage test is due, instead of the
+// grinding scanning every listed pair's history after the step. None may be missed: after
+// every step (its tests run and marked) no listed pair of the committed state is still due,
+// while many were tested on the way, and ore broke.
+TEST(Grinding, TheForceLoopNamesEveryPairWhoseTestIsDue) {
+  Simulation sim(testing_support::grinding_drum_scene());
+  const std::size_t slot = sim.contacts().history_offset("peak_energy");
+  std::size_t named = 0;
+  while (sim.time() < 0.3) {
+    sim.step();
+    named += sim.contacts().breakage_tests_due().size();
+    const PairList& pl = sim.pairs();
+    std::size_t still_due = 0;
+    for (std::size_t k = 0; k < pl.size(); ++k) {
+      const double* h = pl.history_of(k) + slot;
+      still_due += TrackBreakage::test_due(h[TrackBreakage::kPeak], h[TrackBreakage::kEnergy],
+                                           h[TrackBreakage::kTested]);
+    }
+    ASSERT_EQ(still_due, 0u) << "at step " << sim.step_count();
+  }
+  EXPECT_GT(named, 100u);
+  EXPECT_GT(sim.grinding()->totals().breakages, 0);
 }
 
 }  // namespace
