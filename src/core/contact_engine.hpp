@@ -89,6 +89,11 @@ class ContactEngine {
   bool histories_in_place() const { return kernel_->histories_in_place(); }
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
+  // The pairs' histories as the last evaluation wrote them: the committed ones when written in
+  // place, else the trial slots (until the commit).
+  const double* evaluated_pair_histories() const {
+    return histories_in_place() ? pairs_.history.data() : pairs_.trial.data();
+  }
   // See ContactKernel::breakage_tests_due.
   std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }

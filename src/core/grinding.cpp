@@ -56,25 +56,52 @@ Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& dom
   }
 }
 
-bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
-                          Domain& domain, const std::function<void()>& before_change) {
-  std::vector<Broken> broken;
+bool Grinding::plan(double time, std::int64_t step, const ParticleStore& p,
+                    const ContactEngine& contacts, Domain& domain, bool evaluated) {
+  plan_.tested_pairs.clear();
+  plan_.tested_walls.clear();
+  plan_.damage.clear();
+  plan_.broken.clear();
   if (break_material_ >= 0) {
     std::vector<Test> tests;
-    collect_tests(p, contacts, tests);
-    if (time >= scene_.breakage.start) broken = run_tests(tests, step, p);
+    collect_tests(p, contacts, evaluated, tests);
+    if (time >= scene_.breakage.start) run_tests(tests, step, p);
   }
-  std::vector<char> remove(p.n_owned(), 0);
-  double sieved_mass = 0.0;
-  const std::int64_t sieved = sieve_material_ >= 0 ? sieve(time, p, remove, sieved_mass) : 0;
-  const std::int64_t changes =
-      domain.sum(static_cast<std::int64_t>(broken.size()) + sieved);  // one collective per step
-  if (changes != 0) {
+  plan_.remove.assign(p.n_owned(), 0);
+  plan_.product.clear();
+  plan_.sieved = 0;
+  plan_.sieved_mass = 0.0;
+  if (sieve_material_ >= 0) sieve(time, p);
+  plan_.changes = domain.sum(static_cast<std::int64_t>(plan_.broken.size()) +
+                             plan_.sieved);  // one collective per step
+  plan_.feed = feed_due(time);
+  return plan_.changes != 0 || plan_.feed;
+}
+
+bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Domain& domain,
+                     const std::function<void()>& before_change) {
+  if (!plan_.tested_pairs.empty() || !plan_.tested_walls.empty()) {
+    const std::size_t off = contacts.history_offset("peak_energy");
+    const auto mark = [&](double* h) { h[TrackBreakage::kTested] = h[TrackBreakage::kPeak]; };
+    PairList& pl = contacts.mutable_pairs();
+    for (const std::int32_t k : plan_.tested_pairs)
+      mark(pl.history.data() + static_cast<std::size_t>(k) * pl.width + off);
+    WallPairList& wl = contacts.mutable_wall_pairs();
+    for (const std::int32_t k : plan_.tested_walls)
+      mark(wl.history.data() + static_cast<std::size_t>(k) * wl.width + off);
+  }
+  if (!plan_.damage.empty()) {
+    Field<double>& damage = *p.damage();
+    for (const auto& [k, d] : plan_.damage) damage[k] = d;
+  }
+  product_.insert(product_.end(), plan_.product.begin(), plan_.product.end());
+  if (plan_.changes != 0) {
     before_change();
     births_from_ = next_id_;
     // The parents as they were, then the store without them and without the product.
     std::vector<Parent> parents;
-    for (const Broken& b : broken) {
+    std::vector<char>& remove = plan_.remove;
+    for (const Broken& b : plan_.broken) {
       const std::size_t k = b.index;
       parents.push_back(
           {p.id[k], p.material[k], p.radius[k], b.energy, p.pos[k], p.vel[k], p.omega[k]});
@@ -84,21 +111,22 @@ bool Grinding::after_step(double time, std::int64_t step, ParticleStore& p, Cont
       if (remove[k] == 1) discharged_energy_ += particle_energy(p, k, scene_.run.gravity);
     p.remove_if(remove);
     break_parents(time, parents, p, domain);
-    totals_.discharged_count += domain.sum(sieved);
-    totals_.discharged_mass += domain.sum(sieved_mass);
+    totals_.discharged_count += domain.sum(plan_.sieved);
+    totals_.discharged_mass += domain.sum(plan_.sieved_mass);
   }
-  if (!feed_due(time)) return changes != 0;
-  if (changes == 0) {
+  if (!plan_.feed) return plan_.changes != 0;
+  if (plan_.changes == 0) {
     before_change();
     births_from_ = next_id_;
   }
   const bool fed = feed(time, p, domain);
-  return changes != 0 || fed;
+  return plan_.changes != 0 || fed;
 }
 
 // Every contact of an owned breakable particle past its peak and above the level tested, in
-// the order (particle id, partner): pairs in list order, then walls, then sorted.
-void Grinding::collect_tests(const ParticleStore& p, ContactEngine& contacts,
+// the order (particle id, partner): pairs in list order, then walls, then sorted. Every contact
+// past its peak, breakable or not, is marked tested by apply (on every rank that lists it).
+void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contacts, bool evaluated,
                              std::vector<Test>& out) {
   const std::size_t off = contacts.history_offset("peak_energy");
   const std::size_t n_owned = p.n_owned();
@@ -107,64 +135,66 @@ void Grinding::collect_tests(const ParticleStore& p, ContactEngine& contacts,
     return static_cast<std::size_t>(i) < n_owned && p.material[i] == break_material_ &&
            p.radius[i] >= r_min;
   };
-  const auto due = [&](const double* h) {
-    return TrackBreakage::test_due(h[TrackBreakage::kPeak], h[TrackBreakage::kEnergy],
-                                   h[TrackBreakage::kTested]);
-  };
   // The pairs: those the evaluation found due (the only ones: a listed pair not in contact has
   // a zero history), in list order.
-  PairList& pl = contacts.mutable_pairs();
+  const PairList& pl = contacts.pairs();
+  const double* pair_h = evaluated ? contacts.evaluated_pair_histories() : pl.history.data();
   for (const std::int32_t entry : contacts.breakage_tests_due()) {
     const auto k = static_cast<std::size_t>(entry);
-    double* h = pl.history.data() + k * pl.width + off;
+    const double* h = pair_h + k * pl.width + off;
     const std::int32_t i = pl.i[k], j = pl.j[k];
     const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
     if (breakable(i)) out.push_back({pl.id_i[k], pl.id_j[k], std::size_t(i), peak, tested});
     if (breakable(j)) out.push_back({pl.id_j[k], pl.id_i[k], std::size_t(j), peak, tested});
-    h[TrackBreakage::kTested] = peak;  // on every rank that lists the pair alike
+    plan_.tested_pairs.push_back(entry);
   }
-  WallPairList& wl = contacts.mutable_wall_pairs();
+  const WallPairList& wl = contacts.wall_pairs();
+  const double* wall_h = evaluated ? wl.trial.data() : wl.history.data();
   for (std::size_t k = 0; k < wl.size(); ++k) {
-    double* h = wl.history.data() + k * wl.width + off;
-    if (!due(h)) continue;
+    const double* h = wall_h + k * wl.width + off;
+    const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
+    if (!TrackBreakage::test_due(peak, h[TrackBreakage::kEnergy], tested)) continue;
     const std::int32_t i = wl.particle[k];
     if (breakable(i))
-      out.push_back({wl.id[k], -1 - std::int64_t{wl.element[k]}, std::size_t(i),
-                     h[TrackBreakage::kPeak], h[TrackBreakage::kTested]});
-    h[TrackBreakage::kTested] = h[TrackBreakage::kPeak];
+      out.push_back({wl.id[k], -1 - std::int64_t{wl.element[k]}, std::size_t(i), peak, tested});
+    plan_.tested_walls.push_back(static_cast<std::int32_t>(k));
   }
   std::sort(out.begin(), out.end(), [](const Test& a, const Test& b) {
     return a.id < b.id || (a.id == b.id && a.partner < b.partner);
   });
 }
 
-// The tests in order; returns the particles that break (local index, the test's peak energy),
-// in store order.
-std::vector<Grinding::Broken> Grinding::run_tests(const std::vector<Test>& tests, std::int64_t step,
-                                                  ParticleStore& p) const {
+// The tests in order: the particles that break (local index, the test's peak energy), in store
+// order, and the damage of the others. A particle's tests are consecutive (sorted by id): each
+// starts from the damage the one before left.
+void Grinding::run_tests(const std::vector<Test>& tests, std::int64_t step,
+                         const ParticleStore& p) {
   const BreakageSpec& b = scene_.breakage;
   const std::uint64_t seed = stream(scene_.run.seed, kStreamTest);
-  Field<double>& damage = *p.damage();
-  std::vector<Broken> broken;
-  std::int64_t last_broken = -1;
+  const Field<double>& damage = *p.damage();
+  std::vector<Broken>& broken = plan_.broken;
+  std::int64_t last_broken = -1, last_damaged = -1;
   for (const Test& t : tests) {
     if (t.id == last_broken) continue;  // already broken in this step
     const double energy = t.peak - std::max(t.tested, b.minimum_energy);
     if (energy <= 0.0) continue;
-    const double e_t = damage[t.index] + energy;
+    const double before = t.id == last_damaged ? plan_.damage.back().second : damage[t.index];
+    const double e_t = before + energy;
     const double probability = 1.0 - std::exp(-b.strength * e_t);
     const std::uint64_t key =
         mix64(static_cast<std::uint64_t>(t.id)) ^ static_cast<std::uint64_t>(t.partner);
     if (random_uniform(seed, key, static_cast<std::uint64_t>(step)) < probability) {
       broken.push_back({t.index, t.peak});
       last_broken = t.id;
+    } else if (t.id == last_damaged) {
+      plan_.damage.back().second = e_t;
     } else {
-      damage[t.index] = e_t;
+      plan_.damage.emplace_back(t.index, e_t);
+      last_damaged = t.id;
     }
   }
   std::sort(broken.begin(), broken.end(),
             [](const Broken& x, const Broken& y) { return x.index < y.index; });
-  return broken;
 }
 
 int Grinding::fragment_count(std::int64_t parent) const {
@@ -209,21 +239,18 @@ void Grinding::break_parents(double time, const std::vector<Parent>& parents, Pa
   next_id_ = id;
 }
 
-std::int64_t Grinding::sieve(double time, const ParticleStore& p, std::vector<char>& remove,
-                             double& mass) {
+void Grinding::sieve(double time, const ParticleStore& p) {
   const SieveSpec& s = scene_.sieve;
-  std::int64_t n = 0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Vec2 x = p.pos[k];
     if (p.material[k] != sieve_material_ || !(p.radius[k] < s.aperture) || x.x < s.box_min.x ||
         x.x > s.box_max.x || x.y < s.box_min.y || x.y > s.box_max.y)
       continue;
-    remove[k] = 1;
-    product_.push_back({time, p.id[k], p.radius[k], p.mass[k]});
-    mass += p.mass[k];
-    ++n;
+    plan_.remove[k] = 1;
+    plan_.product.push_back({time, p.id[k], p.radius[k], p.mass[k]});
+    plan_.sieved_mass += p.mass[k];
+    ++plan_.sieved;
   }
-  return n;
 }
 
 bool Grinding::feed_due(double time) const {

@@ -73,12 +73,20 @@ class Grinding {
   // The next free id is one above the largest id of the particles placed (all ranks).
   Grinding(const Scene& scene, const ParticleStore& p, const Domain& domain);
 
-  // After a committed step at `time`: tests, breaks, sieve and feed (collective). Returns true,
-  // on every rank alike, when the population changed; the caller then rebuilds and calls
-  // exclude_births(). `before_change` is called just before the store first changes (on every
-  // rank alike; not at all in a step that changes nothing).
-  bool after_step(double time, std::int64_t step, ParticleStore& p, ContactEngine& contacts,
-                  Domain& domain, const std::function<void()>& before_change);
+  // The population step of step `step`, ending at `time`, in two parts. plan: the tests run,
+  // the breaks and the discharges decided, the feed's turn known, from the contact histories
+  // of the step's evaluation (`evaluated`: as the force loop wrote them, before the commit;
+  // else the committed ones) and the positions at the step's end; nothing is changed
+  // (collective). Returns true, on every rank alike, when the population will change: the
+  // step's end state is then read. apply, after the committed step: the plan carried out (the
+  // contacts tested, damage, breaks, product, feed; collective). Returns true, on every rank
+  // alike, when the population changed; the caller then rebuilds and calls exclude_births().
+  // `before_change` is called just before the store first changes (not at all in a step that
+  // changes nothing).
+  bool plan(double time, std::int64_t step, const ParticleStore& p, const ContactEngine& contacts,
+            Domain& domain, bool evaluated);
+  bool apply(double time, ParticleStore& p, ContactEngine& contacts, Domain& domain,
+             const std::function<void()>& before_change);
   // After the rebuild that follows a change: every listed contact of a particle born in it is
   // excluded (the next evaluation keeps the overlapping ones).
   void exclude_births(ContactEngine& contacts) const;
@@ -121,6 +129,17 @@ class Grinding {
     std::size_t index;
     double energy;
   };
+  // What plan decided for apply.
+  struct Plan {
+    std::vector<std::int32_t> tested_pairs, tested_walls;  // list entries: tested := peak
+    std::vector<std::pair<std::size_t, double>> damage;    // particles tested, not broken
+    std::vector<Broken> broken;
+    std::vector<char> remove;  // 1: sieved
+    std::vector<ProductRecord> product;
+    std::int64_t sieved = 0, changes = 0;  // changes: breaks and discharges on every rank
+    double sieved_mass = 0.0;
+    bool feed = false;
+  };
   struct Parent {
     std::int64_t id;
     std::int32_t material;
@@ -128,13 +147,13 @@ class Grinding {
     Vec2 x, v;
     double omega;
   };
-  void collect_tests(const ParticleStore& p, ContactEngine& contacts, std::vector<Test>& out);
-  std::vector<Broken> run_tests(const std::vector<Test>& tests, std::int64_t step,
-                                ParticleStore& p) const;
+  void collect_tests(const ParticleStore& p, const ContactEngine& contacts, bool evaluated,
+                     std::vector<Test>& out);
+  void run_tests(const std::vector<Test>& tests, std::int64_t step, const ParticleStore& p);
   int fragment_count(std::int64_t parent) const;
   void break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
                      Domain& domain);
-  std::int64_t sieve(double time, const ParticleStore& p, std::vector<char>& remove, double& mass);
+  void sieve(double time, const ParticleStore& p);
   bool feed(double time, ParticleStore& p, Domain& domain);
   bool feed_due(double time) const;
   double feed_radius() const;
@@ -150,6 +169,7 @@ class Grinding {
   double fed_energy_ = 0.0, discharged_energy_ = 0.0;
   std::vector<BreakageRecord> breakages_;
   std::vector<ProductRecord> product_;
+  Plan plan_;
 };
 
 }  // namespace dem2d

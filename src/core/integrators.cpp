@@ -69,10 +69,11 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
     s.refresh_ghosts();
   ghosts_ahead_ = false;
   s.contact_forces(dt_, /*owned_cleared=*/true);
+  const bool population_changes = s.population_changes();
   // v += a dt/2, and when allowed the next step's kick-drift in the same pass. Not after a
-  // rebuild: the simulation keeps a backup of the state then.
+  // rebuild (the simulation keeps a backup of the state then), nor before a population change.
   const Vec2* x_build = s.rebuilds().positions_at_build();
-  ahead_ = run_ahead_allowed_ && !rebuilds;
+  ahead_ = run_ahead_allowed_ && !rebuilds && !population_changes;
   const ClosingKick closing = ahead_
                                   ? closing_kick_drift(p, x_build, dt_, gravity_, s.drift_mirror())
                                   : closing_kick(p, x_build, dt_, gravity_);

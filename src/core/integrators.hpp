@@ -72,6 +72,10 @@ class StepStages {
   // Lines for the drift about to run to write the owned particles' new state into, read by the
   // next contact_forces (core/kinematics_mirror.hpp); nullptr when the contact loop keeps none.
   virtual PairKinematics* drift_mirror() = 0;
+  // After the step's force evaluation: whether the ore models change the population at this
+  // step's end (they plan their population step now; collective; false without ore models). The
+  // end state is then read: the step does not run ahead.
+  virtual bool population_changes() = 0;
   // The trial histories become the committed ones; the step's energies are booked, with
   // `late_loss` (J) added to the dissipation the contact laws reported (Verlet's completion of
   // their work to the end-of-step velocity).

@@ -238,13 +238,15 @@ void Simulation::choose_dt() {
 // now (a rebuild may migrate them).
 void Simulation::step(bool end_observed) {
   if (!baseline_taken_) take_energy_baseline();
-  // What reads the state at this step's end: the caller, the energy check, the backup, the ore
-  // models; the last step of the run (the check below, on the same figures). A step that
-  // rebuilds is backed up too: the integrator does not run ahead after a rebuild.
+  // What reads the state at this step's end: the caller, the energy check, the backup; the last
+  // step of the run (the check below, on the same figures); the ore models when they change the
+  // population (the integrator asks them, population_changes). A step that rebuilds is backed up
+  // too: the integrator does not run ahead after a rebuild.
   const std::int64_t next = step_ + 1;
   const bool last = static_cast<double>(next) * dt_ + 0.5 * dt_ >= scene_.run.duration;
-  integrator_->allow_run_ahead(run_ahead_ && !end_observed && !grinding_ && !last &&
+  integrator_->allow_run_ahead(run_ahead_ && !end_observed && !last &&
                                next % kEnergyCheckSteps != 0 && next % kBackupSteps != 0);
+  population_planned_ = false;
   const StepOutcome outcome = integrator_->step(*this);
   ++step_;
   steps_run_ahead_ += integrator_->ran_ahead() ? 1 : 0;
@@ -257,12 +259,22 @@ void Simulation::step(bool end_observed) {
   }
 }
 
+// Velocity Verlet plans the population step within the step (population_changes), the
+// iterative scheme here.
+bool Simulation::population_changes() {
+  if (!grinding_) return false;
+  population_planned_ = true;
+  return grinding_->plan(time_, step_ + 1, particles_, contacts_, *domain_, /*evaluated=*/true);
+}
+
 void Simulation::population_step() {
+  if (!population_planned_)
+    grinding_->plan(time_, step_, particles_, contacts_, *domain_, /*evaluated=*/false);
+  population_planned_ = false;
   // The energy before the change, taken only in a step that changes the store (most do not).
   double before = 0.0;
   const double fed = grinding_->fed_energy(), discharged = grinding_->discharged_energy();
-  if (!grinding_->after_step(time_, step_, particles_, contacts_, *domain_,
-                             [&] { before = local_energy(); }))
+  if (!grinding_->apply(time_, particles_, contacts_, *domain_, [&] { before = local_energy(); }))
     return;
   domain_->population_changed(domain_->sum(static_cast<std::int64_t>(particles_.n_owned())));
   rebuild();

@@ -161,6 +161,7 @@ class Simulation final : private StepStages {
   std::span<FieldBase* const> ghost_fields() override { return ghost_fields_; }
   void contact_forces(double dt, bool owned_cleared) override;
   PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
+  bool population_changes() override;
   void commit(double dt, double late_loss) override;
 
   void choose_dt();
@@ -218,6 +219,7 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
+  bool population_planned_ = false;  // this step's population step planned by the integrator
   // Last known good state, saved every kBackupSteps steps and after every rebuild.
   static constexpr std::int64_t kBackupSteps = 1000;
   StateBackup backup_;
