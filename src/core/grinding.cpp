@@ -81,7 +81,7 @@ bool Grinding::plan(double time, std::int64_t step, const ParticleStore& p,
 bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Domain& domain,
                      const std::function<void()>& before_change) {
   if (!plan_.tested_pairs.empty() || !plan_.tested_walls.empty()) {
-    const std::size_t off = contacts.history_offset("peak_energy");
+    const std::size_t off = plan_.tracker_slot;
     const auto mark = [&](double* h) { h[TrackBreakage::kTested] = h[TrackBreakage::kPeak]; };
     PairList& pl = contacts.mutable_pairs();
     for (const std::int32_t k : plan_.tested_pairs)
@@ -129,6 +129,7 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
 void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contacts, bool evaluated,
                              std::vector<Test>& out) {
   const std::size_t off = contacts.history_offset("peak_energy");
+  plan_.tracker_slot = off;
   const std::size_t n_owned = p.n_owned();
   const double r_min = scene_.breakage.minimum_radius;
   const auto breakable = [&](std::int32_t i) {

@@ -132,6 +132,7 @@ class Grinding {
   // What plan decided for apply.
   struct Plan {
     std::vector<std::int32_t> tested_pairs, tested_walls;  // list entries: tested := peak
+    std::size_t tracker_slot = 0;                          // the histories' "peak_energy" slot
     std::vector<std::pair<std::size_t, double>> damage;    // particles tested, not broken
     std::vector<Broken> broken;
     std::vector<char> remove;  // 1: sieved

@@ -268,9 +268,8 @@ bool Simulation::population_changes() {
 }
 
 void Simulation::population_step() {
-  if (!population_planned_)
+  if (!population_planned_)  // reset at the start of every step
     grinding_->plan(time_, step_, particles_, contacts_, *domain_, /*evaluated=*/false);
-  population_planned_ = false;
   // The energy before the change, taken only in a step that changes the store (most do not).
   double before = 0.0;
   const double fed = grinding_->fed_energy(), discharged = grinding_->discharged_energy();
