@@ -56,6 +56,11 @@ void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
   kernel_->evaluate(p, walls, pairs_, wall_pairs_, dt, totals_);
 }
 
+void ContactEngine::evaluate_paired(ParticleStore& p, const Walls& walls, double dt,
+                                    PairedSweep& sweep, EvaluationTotals& first) {
+  kernel_->evaluate_paired(p, walls, pairs_, wall_pairs_, dt, sweep, first, totals_);
+}
+
 void ContactEngine::commit() {
   if (!kernel_->histories_in_place()) pairs_.history.swap(pairs_.trial);
   wall_pairs_.history.swap(wall_pairs_.trial);

@@ -43,6 +43,26 @@ struct EvaluationTotals {
   std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)
 };
 
+// Velocity Verlet's two steps in one sweep over the pair list (ContactKernel::evaluate_paired,
+// VelocityVerlet::paired_step): told, as the sweep goes, that the forces of a further range of
+// the owned particles are complete, for the first step or for the second. Ranges come in order,
+// each starting where the last ended, their bounds multiples of 8 but for the last, which ends
+// at n_owned.
+class PairedSweep {
+ public:
+  // The first step's forces on owned particles [from, to) are complete (pairs and walls): close
+  // their step and drift them to the second step's state (their mirror lines written).
+  virtual void first_done(std::size_t from, std::size_t to) = 0;
+  // The same for the second step's forces.
+  virtual void second_done(std::size_t from, std::size_t to) = 0;
+  // The walls' contacts of the first step are evaluated: put the walls where they are at the
+  // second step.
+  virtual void walls_to_second() = 0;
+
+ protected:
+  ~PairedSweep() = default;
+};
+
 // The force loop for one contact model, instantiated at setup (contact_engine.cpp).
 class ContactKernel {
  public:
@@ -64,6 +84,16 @@ class ContactKernel {
   // With the breakage tracker: the pair-list entries of the last evaluation whose breakage test
   // is due (TrackBreakage::test_due of their new histories), in list order. Empty otherwise.
   virtual std::span<const std::int32_t> breakage_tests_due() const { return {}; }
+  // Whether evaluate_paired is available (histories written in place, nothing tracked).
+  virtual bool pairs_steps() const { return false; }
+  // Two force evaluations in one sweep over the lists, the second at the state the first step's
+  // closing kick and drift (told through `sweep`) leave: the same forces, histories and totals,
+  // bit for bit, as two evaluations with the steps between them. The pair list in canonical order
+  // and no ghosts; the walls at the first step's pose, moved by `sweep` between the two. The wall
+  // histories end where they would after two evaluations and two commits.
+  virtual void evaluate_paired(ParticleStore& /*p*/, const Walls& /*walls*/, PairList& /*pl*/,
+                               WallPairList& /*wl*/, double /*dt*/, PairedSweep& /*sweep*/,
+                               EvaluationTotals& /*first*/, EvaluationTotals& /*second*/) {}
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.
@@ -87,6 +117,10 @@ class ContactEngine {
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
   // See ContactKernel::histories_in_place.
   bool histories_in_place() const { return kernel_->histories_in_place(); }
+  // See ContactKernel::pairs_steps and evaluate_paired (`second` becomes totals()).
+  bool pairs_steps() const { return kernel_->pairs_steps() && pairs_.canonical(); }
+  void evaluate_paired(ParticleStore& p, const Walls& walls, double dt, PairedSweep& sweep,
+                       EvaluationTotals& first);
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
   // The pairs' histories as the last evaluation wrote them: the committed ones when written in
@@ -97,6 +131,8 @@ class ContactEngine {
   // See ContactKernel::breakage_tests_due.
   std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }
+  // Put back the totals of an earlier evaluation (a paired step's first, for its guards).
+  void restore_totals(const EvaluationTotals& t) { totals_ = t; }
   // The trial histories become the committed ones.
   void commit();
 

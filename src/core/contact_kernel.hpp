@@ -104,9 +104,16 @@ class Kernel final : public ContactKernel {
     live_pairs_.swap(next_live_pairs_);
     live_walls_.swap(next_live_walls_);
   }
-  void lists_changed() override { rescan_ = true; }
+  void lists_changed() override {
+    rescan_ = true;
+    sweep_plan_stale_ = true;
+  }
   bool histories_in_place() const override { return kInPlace; }
   std::span<const std::int32_t> breakage_tests_due() const override { return tests_due_; }
+  bool pairs_steps() const override { return kInPlace && !kFlagsTests; }
+  void evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl, WallPairList& wl,
+                       double dt, PairedSweep& sweep, EvaluationTotals& first,
+                       EvaluationTotals& second) override;
   PairKinematics* drift_mirror(const ParticleStore& p) override {
 #if DEM2D_VECTOR_GATHER
     if (vector_gather_) {
@@ -143,6 +150,24 @@ class Kernel final : public ContactKernel {
     return out;
   }
 
+  // What a pair loop adds up as it goes (pair_contacts, evaluate_paired).
+  struct PairTotals {
+    Pack dissipated{0.0}, elastic{0.0};
+    double max_ratio = 0.0;
+    std::int64_t contacts = 0, worst_a = -1, worst_b = -1;
+    void into(EvaluationTotals& tot) const {
+      tot.contacts += contacts;
+      tot.dissipated = stdx::reduce(dissipated);
+      tot.elastic = stdx::reduce(elastic);
+      tot.max_overlap = max_ratio;
+      tot.worst_a = worst_a;
+      tot.worst_b = worst_b;
+    }
+  };
+  static constexpr std::size_t kChunk = 512;
+  void prepare_pairs(ParticleStore& p, PairList& pl);
+  void pair_chunk(ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1, double dt,
+                  PairTotals& t);
   void pair_contacts(ParticleStore& p, PairList& pl, double dt, EvaluationTotals& tot);
   std::size_t gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1);
   void find_live(const PairList& pl, const WallPairList& wl);
@@ -169,10 +194,28 @@ class Kernel final : public ContactKernel {
   void sum_records(ParticleStore& p, const PairList& pl);
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                      EvaluationTotals& tot);
-  std::size_t gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl);
+  // Wall entries `entries[0, count)` (null: all, in list order), their histories read from `old`
+  // and rewritten into `fresh`.
+  std::size_t gather_walls(const ParticleStore& p, const Walls& walls, const WallPairList& wl,
+                           const std::int32_t* entries, std::size_t count, const double* old,
+                           double* fresh);
   void evaluate_walls(std::size_t n, double dt);
   void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
                      EvaluationTotals& tot);
+  // The paired sweep's wall contacts (evaluate_paired): each contact's forces and its shares of
+  // the totals, kept per list entry, added to the particles when their pairs are done and to the
+  // totals in list order at the end: what scatter_walls adds, in its order.
+  struct WallRecord {
+    double fx, fy, torque, ex, ey, diss_law, el_law, diss_roll, el_roll, drive, drum, ratio;
+    bool touch, on_drum, lifter;
+  };
+  void record_walls(const Walls& walls, const WallPairList& wl, std::size_t n, double* fresh,
+                    std::vector<WallRecord>& out);
+  void apply_walls(ParticleStore& p, const WallPairList& wl, const std::vector<WallRecord>& rec,
+                   std::size_t& cursor, std::size_t end) const;
+  void wall_totals(const ParticleStore& p, const WallPairList& wl,
+                   const std::vector<WallRecord>& rec, EvaluationTotals& tot) const;
+  void plan_sweep(const PairList& pl, const WallPairList& wl);
 
   int n_mat_;
   std::vector<Coeffs> coeffs_;  // [a * n_mat_ + b]
@@ -218,6 +261,11 @@ class Kernel final : public ContactKernel {
   };
   Array<std::uint8_t> touch_;
   Array<ForceRecord> records_;
+  // The paired sweep's plan, made again after every rebuild: per chunk the largest partner
+  // index, and the wall entries in particle order (stable: list order within a particle).
+  bool sweep_plan_stale_ = true;
+  std::vector<std::int32_t> chunk_last_j_, wall_order_;
+  std::vector<WallRecord> wall_first_, wall_second_;
 };
 
 // The candidates are processed in chunks, each through phases A, B and C, so that the batch
@@ -225,9 +273,7 @@ class Kernel final : public ContactKernel {
 // through memory: 1.7x slower per particle-step at 1e5 particles). Chunks run in list order, so
 // the scatter stays canonical.
 template <class Model>
-void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
-                                  EvaluationTotals& tot) {
-  constexpr std::size_t kChunk = 512;
+void Kernel<Model>::prepare_pairs(ParticleStore& p, PairList& pl) {
   b_.reserve(kChunk + kPackSize);
   if (bi_.size() < kChunk + kPackSize) {
     bi_.resize(kChunk + kPackSize);
@@ -244,36 +290,46 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
     touch_.assign(pl.size(), 0);
     records_.resize(2 * pl.size());
   }
-  Pack dissipated(0.0), elastic(0.0);
-  double max_ratio = 0.0;
-  for (std::size_t k0 = 0; k0 < pl.size(); k0 += kChunk) {
-    const std::size_t n = gather_pairs(p, pl, k0, std::min(pl.size(), k0 + kChunk));
-    Pack chunk_overlap(0.0);
-    evaluate_pairs(n, dt, dissipated, elastic, chunk_overlap);
-    scatter_pairs(p, pl, n);
-    // The chunk's contacts, for release_ended next step (out of the scatter loop: a push_back
-    // there cost 7 % on the waterfall).
-    if constexpr (kTrackRelease)
-      next_live_pairs_.insert(next_live_pairs_.end(), b_.pair.data(), b_.pair.data() + n);
-    if constexpr (kFlagsTests) note_tests_due(n);
-    // Counted apart from the scatter: this loop vectorises, the scatter cannot.
-    for (std::size_t c = 0; c < n; ++c) tot.contacts += b_.counted[c] > 0.5 ? 1 : 0;
-    // The first pair at the largest overlap so far names the culprits of a blow-up.
-    const double chunk_max = stdx::hmax(chunk_overlap);
-    if (chunk_max > kMaxOverlapRatio && chunk_max > max_ratio) {
-      for (std::size_t c = 0; c < n; ++c)
-        if (b_.overlap[c] == chunk_max) {
-          tot.worst_a = p.id[pl.i[b_.pair[c]]];
-          tot.worst_b = p.id[pl.j[b_.pair[c]]];
-          break;
-        }
-    }
-    max_ratio = std::max(max_ratio, chunk_max);
+}
+
+// Candidates [k0, k1): phases A, B and C.
+template <class Model>
+[[gnu::always_inline]] inline void Kernel<Model>::pair_chunk(ParticleStore& p, PairList& pl,
+                                                             std::size_t k0, std::size_t k1,
+                                                             double dt, PairTotals& t) {
+  const std::size_t n = gather_pairs(p, pl, k0, k1);
+  Pack chunk_overlap(0.0);
+  evaluate_pairs(n, dt, t.dissipated, t.elastic, chunk_overlap);
+  scatter_pairs(p, pl, n);
+  // The chunk's contacts, for release_ended next step (out of the scatter loop: a push_back
+  // there cost 7 % on the waterfall).
+  if constexpr (kTrackRelease)
+    next_live_pairs_.insert(next_live_pairs_.end(), b_.pair.data(), b_.pair.data() + n);
+  if constexpr (kFlagsTests) note_tests_due(n);
+  // Counted apart from the scatter: this loop vectorises, the scatter cannot.
+  for (std::size_t c = 0; c < n; ++c) t.contacts += b_.counted[c] > 0.5 ? 1 : 0;
+  // The first pair at the largest overlap so far names the culprits of a blow-up.
+  const double chunk_max = stdx::hmax(chunk_overlap);
+  if (chunk_max > kMaxOverlapRatio && chunk_max > t.max_ratio) {
+    for (std::size_t c = 0; c < n; ++c)
+      if (b_.overlap[c] == chunk_max) {
+        t.worst_a = p.id[pl.i[b_.pair[c]]];
+        t.worst_b = p.id[pl.j[b_.pair[c]]];
+        break;
+      }
   }
+  t.max_ratio = std::max(t.max_ratio, chunk_max);
+}
+
+template <class Model>
+void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
+                                  EvaluationTotals& tot) {
+  prepare_pairs(p, pl);
+  PairTotals t;
+  for (std::size_t k0 = 0; k0 < pl.size(); k0 += kChunk)
+    pair_chunk(p, pl, k0, std::min(pl.size(), k0 + kChunk), dt, t);
   if (!pl.canonical()) sum_records(p, pl);
-  tot.dissipated = stdx::reduce(dissipated);
-  tot.elastic = stdx::reduce(elastic);
-  tot.max_overlap = max_ratio;
+  t.into(tot);
 }
 
 // A contact that ended in this step releases the energy its springs held at the end of the last
@@ -556,7 +612,8 @@ template <class Model>
 void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                                   EvaluationTotals& tot) {
   wb_.reserve(wl.size() + kPackSize);
-  const std::size_t n = gather_walls(p, walls, wl);
+  const std::size_t n =
+      gather_walls(p, walls, wl, nullptr, wl.size(), wl.history.data(), wl.trial.data());
   evaluate_walls(n, dt);
   scatter_walls(p, walls, wl, n, tot);
   if constexpr (kTrackRelease)
@@ -566,7 +623,8 @@ void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPair
 
 template <class Model>
 std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& walls,
-                                        WallPairList& wl) {
+                                        const WallPairList& wl, const std::int32_t* entries,
+                                        std::size_t count, const double* old, double* fresh) {
   const Vec2* x = p.pos.data();
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
@@ -575,9 +633,10 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
   const WallElement* elements = walls.elements().data();
   const WallBody* bodies = walls.bodies().data();
   std::size_t n = 0;
-  for (std::size_t k = 0; k < wl.size(); ++k) {
+  for (std::size_t e_k = 0; e_k < count; ++e_k) {
+    const std::size_t k = entries ? static_cast<std::size_t>(entries[e_k]) : e_k;
     const std::int32_t i = wl.particle[k];
-    for (std::size_t s = 0; s < W; ++s) wl.trial[k * W + s] = 0.0;  // the scatter rewrites contacts
+    for (std::size_t s = 0; s < W; ++s) fresh[k * W + s] = 0.0;  // the scatter rewrites contacts
     const WallElement& e = elements[wl.element[k]];
     WallGeometry g;
     if (e.kind == WallKind::kCircle) {
@@ -607,7 +666,7 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     wb_.vx[n] = vrel.x;
     wb_.vy[n] = vrel.y;
     wb_.omega_rel[n] = w[i] - bodies[e.body].omega;
-    for (std::size_t s = 0; s < W; ++s) wb_.history.old[s][n] = wl.history[k * W + s];
+    for (std::size_t s = 0; s < W; ++s) wb_.history.old[s][n] = old[k * W + s];
     wb_.wx[n] = vw.x;
     wb_.wy[n] = vw.y;
     wb_.px[n] = g.point.x;
@@ -696,6 +755,193 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
   tot.dissipated = dissipated;
   tot.elastic = elastic;
   tot.max_overlap = max_ratio;
+}
+
+// The paired sweep's wall contacts: the gathered contacts' new histories into `fresh` and their
+// records (per list entry), with scatter_walls's expressions.
+template <class Model>
+void Kernel<Model>::record_walls(const Walls& walls, const WallPairList& wl, std::size_t n,
+                                 double* fresh, std::vector<WallRecord>& out) {
+  const WallElement* elements = walls.elements().data();
+  const WallBody* bodies = walls.bodies().data();
+  const int drum = walls.drum_body();
+  const Vec2 drum_center = walls.has_drum() ? bodies[drum].center : Vec2{};
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t k = wb_.pair[c];
+    const WallElement& e = elements[wl.element[k]];
+    const Vec2 fi{wb_.fx[c], wb_.fy[c]};
+    const double m_roll = wb_.m_roll[c];
+    for (std::size_t s = 0; s < W; ++s)
+      fresh[static_cast<std::size_t>(k) * W + s] = wb_.history.fresh[s][c];
+    WallRecord& r = out[k];
+    r = WallRecord{fi.x,
+                   fi.y,
+                   wb_.torque[c],
+                   wb_.ex[c],
+                   wb_.ey[c],
+                   wb_.diss_law[c],
+                   wb_.el_law[c],
+                   wb_.diss_roll[c],
+                   wb_.el_roll[c],
+                   dot(fi, Vec2{wb_.wx[c], wb_.wy[c]}) + m_roll * bodies[e.body].omega,
+                   0.0,
+                   wb_.delta[c] / wb_.r[c],
+                   true,
+                   e.body == drum,
+                   e.part == WallPart::kLifter};
+    if (r.on_drum) r.drum = cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
+  }
+}
+
+// The recorded wall forces on the particles below `end` (wall_order_ from `cursor`).
+template <class Model>
+void Kernel<Model>::apply_walls(ParticleStore& p, const WallPairList& wl,
+                                const std::vector<WallRecord>& rec, std::size_t& cursor,
+                                std::size_t end) const {
+  Vec2* f = p.force.data();
+  double* tq = p.torque.data();
+  Vec2* f_el = p.elastic_force.data();
+  for (; cursor < wall_order_.size(); ++cursor) {
+    const std::int32_t k = wall_order_[cursor];
+    const auto i = static_cast<std::size_t>(wl.particle[k]);
+    if (i >= end) break;
+    const WallRecord& r = rec[k];
+    if (!r.touch) continue;
+    f[i] += Vec2{r.fx, r.fy};
+    tq[i] += r.torque;
+    f_el[i] += Vec2{r.ex, r.ey};
+  }
+}
+
+// The recorded contacts' shares of the totals in list order, after the pairs': scatter_walls's.
+template <class Model>
+void Kernel<Model>::wall_totals(const ParticleStore& p, const WallPairList& wl,
+                                const std::vector<WallRecord>& rec, EvaluationTotals& tot) const {
+  double dissipated = tot.dissipated, elastic = tot.elastic, max_ratio = tot.max_overlap;
+  for (std::size_t k = 0; k < wl.size(); ++k) {
+    const WallRecord& r = rec[k];
+    if (!r.touch) continue;
+    dissipated += r.diss_law;
+    elastic += r.el_law;
+    if constexpr (Model::Rolling::kActive) {
+      dissipated += r.diss_roll;
+      elastic += r.el_roll;
+    }
+    tot.drive_power += r.drive;
+    if (r.on_drum) {
+      tot.drum_torque += r.drum;
+      if (r.lifter) tot.lifter_torque += r.drum;
+    }
+    if (r.ratio > max_ratio) {
+      max_ratio = r.ratio;
+      tot.worst_a = p.id[wl.particle[k]];
+      tot.worst_b = -1;
+    }
+    tot.contacts += 1;
+  }
+  tot.dissipated = dissipated;
+  tot.elastic = elastic;
+  tot.max_overlap = max_ratio;
+}
+
+template <class Model>
+void Kernel<Model>::plan_sweep(const PairList& pl, const WallPairList& wl) {
+  const std::size_t chunks = (pl.size() + kChunk - 1) / kChunk;
+  chunk_last_j_.assign(chunks, 0);
+  for (std::size_t c = 0; c < chunks; ++c)
+    for (std::size_t k = c * kChunk; k < std::min(pl.size(), (c + 1) * kChunk); ++k)
+      chunk_last_j_[c] = std::max(chunk_last_j_[c], pl.j[k]);
+  wall_order_.resize(wl.size());
+  for (std::size_t k = 0; k < wl.size(); ++k) wall_order_[k] = static_cast<std::int32_t>(k);
+  std::stable_sort(wall_order_.begin(), wall_order_.end(),
+                   [&](std::int32_t a, std::int32_t b) { return wl.particle[a] < wl.particle[b]; });
+  sweep_plan_stale_ = false;
+}
+
+// Two steps in one sweep (ContactKernel::evaluate_paired). The first step's chunks run in list
+// order as in pair_contacts; after each, the owned particles below the next chunk's first
+// particle (rounded down to a multiple of 8) have all their pairs: their first-step wall forces
+// are added (evaluated before the sweep, at the first pose), the sweep closes and drifts them,
+// and their second-step wall contacts are evaluated at once (the walls at the second pose). A
+// second-step chunk runs as soon as every particle it names has been drifted, and hands its
+// complete particles to the sweep the same way. Each particle's sums are the same additions in
+// the same order as in two evaluations; the totals are added in the same order too.
+template <class Model>
+void Kernel<Model>::evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl,
+                                    WallPairList& wl, double dt, PairedSweep& sweep,
+                                    EvaluationTotals& first, EvaluationTotals& second) {
+  if constexpr (!kInPlace || kFlagsTests) {
+    throw std::logic_error("evaluate_paired: this contact model does not pair steps");
+  } else {
+    first = EvaluationTotals{};
+    second = EvaluationTotals{};
+    if (sweep_plan_stale_) plan_sweep(pl, wl);
+    const std::size_t n = p.n_owned();
+    wall_first_.assign(wl.size(), WallRecord{});
+    wall_second_.assign(wl.size(), WallRecord{});
+    wb_.reserve(wl.size() + kPackSize);
+    // The first step's wall contacts, at the first pose; histories into the trial slots.
+    std::size_t nw =
+        gather_walls(p, walls, wl, nullptr, wl.size(), wl.history.data(), wl.trial.data());
+    evaluate_walls(nw, dt);
+    record_walls(walls, wl, nw, wl.trial.data(), wall_first_);
+    sweep.walls_to_second();
+    prepare_pairs(p, pl);
+    PairTotals ta, tb;
+    const std::size_t chunks = (pl.size() + kChunk - 1) / kChunk;
+    std::size_t done_a = 0, done_b = 0, next_b = 0;
+    std::size_t walls_a = 0, walls_b_evaluated = 0, walls_b = 0;  // cursors in wall_order_
+    const auto complete_after = [&](std::size_t c) {
+      return c + 1 < chunks ? static_cast<std::size_t>(pl.i[(c + 1) * kChunk]) & ~std::size_t{7}
+                            : n;
+    };
+    // The first step's hand-over of [done_a, to), then the second step's wall contacts there.
+    const auto first_done = [&](std::size_t to) {
+      apply_walls(p, wl, wall_first_, walls_a, to);
+      sweep.first_done(done_a, to);
+      const std::size_t from = walls_b_evaluated;
+      while (walls_b_evaluated < wall_order_.size() &&
+             static_cast<std::size_t>(wl.particle[wall_order_[walls_b_evaluated]]) < to)
+        ++walls_b_evaluated;
+      if (walls_b_evaluated > from) {
+        // Second step: the first step's new histories (trial) are the old ones.
+        const std::size_t m =
+            gather_walls(p, walls, wl, wall_order_.data() + from, walls_b_evaluated - from,
+                         wl.trial.data(), wl.history.data());
+        evaluate_walls(m, dt);
+        record_walls(walls, wl, m, wl.history.data(), wall_second_);
+      }
+      done_a = to;
+    };
+    // Not past the first step's hand-over: a particle without pairs is complete for the second
+    // step as soon as the first has drifted it.
+    const auto second_done = [&](std::size_t to) {
+      to = std::min(to, done_a);
+      if (to <= done_b) return;
+      apply_walls(p, wl, wall_second_, walls_b, to);
+      sweep.second_done(done_b, to);
+      done_b = to;
+    };
+    const auto second_chunks = [&](bool all) {
+      while (next_b < chunks && (all || static_cast<std::size_t>(chunk_last_j_[next_b]) < done_a)) {
+        pair_chunk(p, pl, next_b * kChunk, std::min(pl.size(), (next_b + 1) * kChunk), dt, tb);
+        second_done(complete_after(next_b++));
+      }
+    };
+    for (std::size_t c = 0; c < chunks; ++c) {
+      pair_chunk(p, pl, c * kChunk, std::min(pl.size(), (c + 1) * kChunk), dt, ta);
+      const std::size_t to = complete_after(c);
+      if (to > done_a) first_done(to);
+      second_chunks(false);
+    }
+    if (done_a < n) first_done(n);
+    second_chunks(true);
+    if (done_b < n) second_done(n);
+    ta.into(first);
+    tb.into(second);
+    wall_totals(p, wl, wall_first_, first);
+    wall_totals(p, wl, wall_second_, second);
+  }
 }
 
 // The stepper follows the integrator (contact_models.hpp, Steppers).

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace dem2d {
 
@@ -79,7 +80,7 @@ StepOutcome VelocityVerlet::step(StepStages& s) {
                                   : closing_kick(p, x_build, dt_, gravity_);
   s.commit(dt_, closing.late_loss);
   passes_.add(1);
-  return end_of_step_round(s, closing);
+  return end_of_step_round(s, closing, s.totals().max_overlap);
 }
 
 namespace {
@@ -325,54 +326,103 @@ template <bool kDrift>
                c.m, c.mat, c.mirror);
 }
 
-// close_four over particles [0, 8 floor(n / 8)), eight per iteration (the sums' lanes 0-3 and
-// 4-7 in two registers each). Returns where it stopped.
-template <bool kDrift>
-std::size_t close_fours(std::size_t n, double h, double dt, Vec2 g, const ClosingColumns& c,
-                        ClosingSums& sums) {
-  FourMaxima most;
-  __m256d checksum[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
-  __m256d late[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
-  const std::size_t whole = n / kSumLanes * kSumLanes;
-  for (std::size_t k = 0; k < whole; k += 8) {
-    close_four<kDrift>(k, h, dt, g, c, most, checksum[0], late[0]);
-    close_four<kDrift>(k + 4, h, dt, g, c, most, checksum[1], late[1]);
-  }
-  for (std::size_t half = 0; half < 2; ++half) {
-    _mm256_storeu_pd(sums.checksum + 4 * half, checksum[half]);
-    _mm256_storeu_pd(sums.late_power + 4 * half, late[half]);
-  }
-  alignas(32) double lanes[3][4];
-  _mm256_store_pd(lanes[0], most.disp2);
-  _mm256_store_pd(lanes[1], most.speed2);
-  _mm256_store_pd(lanes[2], most.motion2);
-  for (std::size_t l = 0; l < 4; ++l) {
-    sums.disp2 = keep_larger(sums.disp2, lanes[0][l]);
-    sums.speed2 = keep_larger(sums.speed2, lanes[1][l]);
-    sums.motion2 = keep_larger(sums.motion2, lanes[2][l]);
-  }
-  return whole;
-}
 #endif
 
-// closing_kick (kDrift false) and closing_kick_drift (true).
+// The closing pass over the owned particles, run over consecutive ranges [from, to) (bounds
+// multiples of 8 but for the last, which ends at n; one range [0, n) is the whole pass): eight
+// particles per iteration over the first whole eights, with the sums' lanes 0-3 and 4-7 in two
+// registers each carried from range to range, then the rest one at a time into lane 0. Any cut
+// into such ranges gives the bits of one pass (VelocityVerlet::paired_step hands them over as
+// the pair loop completes them).
+template <bool kDrift>
+class ClosingRanges {
+ public:
+  ClosingRanges(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
+                PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time)
+      : c_(closing_columns(p, x_build, mirror)),
+        h_(0.5 * dt),
+        dt_(dt),
+        g_(gravity),
+        n_(p.n_owned()),
+        whole_(n_ / kSumLanes * kSumLanes) {
+#if DEM2D_VECTOR_GATHER
+    fours_ = four_at_a_time;
+#endif
+  }
+  void run(std::size_t from, std::size_t to) {
+    std::size_t k = from;
+#if DEM2D_VECTOR_GATHER
+    if (fours_) {
+      const ClosingColumns c = c_;  // local: the stores below may alias the object (eighth session)
+      FourMaxima most = most_;
+      __m256d checksum0 = checksum_[0], checksum1 = checksum_[1];
+      __m256d late0 = late_[0], late1 = late_[1];
+      const std::size_t end = std::min(to, whole_);
+      for (; k < end; k += 8) {
+        close_four<kDrift>(k, h_, dt_, g_, c, most, checksum0, late0);
+        close_four<kDrift>(k + 4, h_, dt_, g_, c, most, checksum1, late1);
+      }
+      most_ = most;
+      checksum_[0] = checksum0;
+      checksum_[1] = checksum1;
+      late_[0] = late0;
+      late_[1] = late1;
+      if (k < to) flush();
+    }
+#endif
+    const ClosingColumns c = c_;
+    for (; k < to; ++k) {
+      close_one(k, sum_lane(k, whole_), h_, g_, c, sums_);
+      if constexpr (kDrift)
+        drift_one(k, h_, dt_, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
+    }
+  }
+  ClosingKick result() {
+#if DEM2D_VECTOR_GATHER
+    if (fours_) flush();
+#endif
+    return sums_.result(dt_);
+  }
+
+ private:
+#if DEM2D_VECTOR_GATHER
+  // The lanes into the sums, once, before the first particle past the whole eights.
+  void flush() {
+    if (flushed_) return;
+    flushed_ = true;
+    for (std::size_t half = 0; half < 2; ++half) {
+      _mm256_storeu_pd(sums_.checksum + 4 * half, checksum_[half]);
+      _mm256_storeu_pd(sums_.late_power + 4 * half, late_[half]);
+    }
+    alignas(32) double lanes[3][4];
+    _mm256_store_pd(lanes[0], most_.disp2);
+    _mm256_store_pd(lanes[1], most_.speed2);
+    _mm256_store_pd(lanes[2], most_.motion2);
+    for (std::size_t l = 0; l < 4; ++l) {
+      sums_.disp2 = keep_larger(sums_.disp2, lanes[0][l]);
+      sums_.speed2 = keep_larger(sums_.speed2, lanes[1][l]);
+      sums_.motion2 = keep_larger(sums_.motion2, lanes[2][l]);
+    }
+  }
+  bool fours_ = false, flushed_ = false;
+  FourMaxima most_;
+  __m256d checksum_[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+  __m256d late_[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+#endif
+  ClosingColumns c_;
+  double h_, dt_;
+  Vec2 g_;
+  std::size_t n_, whole_;
+  ClosingSums sums_;
+};
+
+// closing_kick (kDrift false) and closing_kick_drift (true): one range.
 template <bool kDrift>
 ClosingKick close(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
-                  PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time) {
-  const double h = 0.5 * dt;
-  const std::size_t n = p.n_owned(), whole = n / kSumLanes * kSumLanes;
-  const ClosingColumns c = closing_columns(p, x_build, mirror);
-  ClosingSums sums;
-  std::size_t from = 0;
-#if DEM2D_VECTOR_GATHER
-  if (four_at_a_time) from = close_fours<kDrift>(n, h, dt, gravity, c, sums);
-#endif
-  for (std::size_t k = from; k < n; ++k) {
-    close_one(k, sum_lane(k, whole), h, gravity, c, sums);
-    if constexpr (kDrift)
-      drift_one(k, h, dt, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
-  }
-  return sums.result(dt);
+                  PairKinematics* mirror, bool four_at_a_time) {
+  ClosingRanges<kDrift> pass(p, x_build, dt, gravity, mirror, four_at_a_time);
+  pass.run(0, p.n_owned());
+  return pass.result();
 }
 
 }  // namespace
@@ -385,6 +435,96 @@ ClosingKick closing_kick(ParticleStore& p, const Vec2* x_build, double dt, Vec2 
 ClosingKick closing_kick_drift(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
                                PairKinematics* mirror, bool four_at_a_time) {
   return close<true>(p, x_build, dt, gravity, mirror, four_at_a_time);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Two steps in one sweep
+
+// Past the caches each step streams the whole store twice (the pair loop, then the closing kick
+// and drift); a pair of steps in one sweep streams it about once: the second step's pair loop
+// follows the first's a few hundred particles behind, on lines still in the cache.
+//
+// The second step's evaluation uses the lists as they are, so they must hold every contact of
+// the second step's positions, which are known only as the sweep goes. The step count decides
+// to pair only with a wide margin: the last round's bound on the displacement since the build
+// at the coming drift's end, plus four times that drift's largest move for the next one, plus a
+// fiftieth of the skin, must not make a rebuild due two steps ahead. After the sweep the
+// first step's round checks the true bound (a particle would have had to speed up fourfold in
+// one step): if it fails, the run stops with an internal error rather than go on unexact.
+bool VelocityVerlet::can_pair(const StepStages& s) const {
+  if (!ahead_ || rebuild_next_ || ghosts_ahead_ || !elastic_cleared_) return false;
+  const double skin = s.rebuilds().skin();
+  // The walls three steps on: where the first step's round will look from (paired_step).
+  return !s.rebuilds().due(bound_ + 4.0 * drift_move_ + 0.02 * skin, s.walls(), s.time(),
+                           3.0 * dt_);
+}
+
+namespace {
+
+// What the kernel's sweep hands over: the first step's particles closed and drifted, the
+// second's closed (and drifted when the second step runs ahead).
+template <bool kSecondDrift>
+class PairedClosing final : public PairedSweep {
+ public:
+  PairedClosing(StepStages& s, const Vec2* x_build, double dt, Vec2 gravity, PairKinematics* mirror)
+      : s_(s),
+        first_(s.particles(), x_build, dt, gravity, mirror, true),
+        second_(s.particles(), x_build, dt, gravity, kSecondDrift ? mirror : nullptr, true) {}
+  void first_done(std::size_t from, std::size_t to) override { first_.run(from, to); }
+  void second_done(std::size_t from, std::size_t to) override { second_.run(from, to); }
+  void walls_to_second() override {
+    drum_omega_ = s_.walls().drum_omega();
+    s_.advance_clock_second();
+  }
+  ClosingKick first() { return first_.result(); }
+  ClosingKick second() { return second_.result(); }
+  double drum_omega() const { return drum_omega_; }
+
+ private:
+  StepStages& s_;
+  ClosingRanges<true> first_;
+  ClosingRanges<kSecondDrift> second_;
+  double drum_omega_ = 0.0;
+};
+
+}  // namespace
+
+std::pair<StepOutcome, StepOutcome> Integrator::paired_step(StepStages&, bool) {
+  throw std::logic_error("paired_step: this integrator does not pair steps");
+}
+
+std::pair<StepOutcome, StepOutcome> VelocityVerlet::paired_step(StepStages& s, bool second_ahead) {
+  s.advance_clock();
+  const Vec2* x_build = s.rebuilds().positions_at_build();
+  PairKinematics* mirror = s.drift_mirror();
+  const auto run = [&](auto& sweep) {
+    EvaluationTotals first;
+    s.paired_contact_forces(dt_, sweep, first);
+    const ClosingKick a = sweep.first(), b = sweep.second();
+    s.commit_first(dt_, a.late_loss, first, sweep.drum_omega());
+    passes_.add(1);
+    ahead_ = true;
+    const StepOutcome out_a = end_of_step_round(s, a, first.max_overlap);
+    if (rebuild_next_ && !out_a.unstable)
+      throw std::logic_error(
+          "two steps in one sweep: the second step's positions needed new neighbour lists "
+          "(a particle sped up more than the margin allows); run again with fewer particles "
+          "per rank or report this");
+    s.commit(dt_, b.late_loss);
+    passes_.add(1);
+    ahead_ = second_ahead;
+    return std::pair{out_a, end_of_step_round(s, b, s.totals().max_overlap)};
+  };
+  std::pair<StepOutcome, StepOutcome> out;
+  if (second_ahead) {
+    PairedClosing<true> sweep(s, x_build, dt_, gravity_, mirror);
+    out = run(sweep);
+    s.drift_mirror();  // the second drift wrote the owned lines: the next fill keeps them
+  } else {
+    PairedClosing<false> sweep(s, x_build, dt_, gravity_, mirror);
+    out = run(sweep);
+  }
+  return out;
 }
 
 // The drift taken back (a failed step's report): x - dt v, v - a dt/2, w - alpha dt/2,
@@ -408,10 +548,11 @@ void VelocityVerlet::step_back(ParticleStore& p) {
 // their speed times dt more. In parallel the same round hands the ghosts the state their owners
 // drift them to next, and the next step skips the refresh (wasted when it rebuilds, one step in
 // a hundred or more).
-StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& c) {
+StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& c,
+                                              double max_overlap) {
   const double motion = dt_ * std::sqrt(c.motion2);
-  const bool local_ok = std::isfinite(c.checksum) && s.totals().max_overlap <= kMaxOverlapRatio &&
-                        motion <= kMaxStepMotion;
+  const bool local_ok =
+      std::isfinite(c.checksum) && max_overlap <= kMaxOverlapRatio && motion <= kMaxStepMotion;
   double reduce[2] = {local_ok ? 0.0 : 1.0, std::sqrt(c.disp2) + dt_ * std::sqrt(c.speed2)};
   Domain& domain = s.domain();
   if (domain.size() > 1) {
@@ -423,6 +564,8 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& 
   }
   if (!std::isfinite(reduce[1])) reduce[0] = 1.0;
   rebuild_next_ = s.rebuilds().due(reduce[1], s.walls(), s.time(), dt_);
+  bound_ = reduce[1];
+  drift_move_ = dt_ * std::sqrt(c.speed2);
   StepOutcome out{reduce[0] != 0.0, c.checksum, motion};
   if (out.unstable && motion > kMaxStepMotion) {  // name the particle (rare: only now)
     const ParticleStore& p = s.particles();

@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/contact_engine.hpp"
@@ -80,6 +81,16 @@ class StepStages {
   // `late_loss` (J) added to the dissipation the contact laws reported (Verlet's completion of
   // their work to the end-of-step velocity).
   virtual void commit(double dt, double late_loss) = 0;
+  // Two steps in one sweep (VelocityVerlet::paired_step): both force evaluations, the closing
+  // kicks and drifts told through `sweep` (ContactKernel::evaluate_paired); the first step's
+  // totals into `first`, the second's become totals(). The walls are moved to the second step
+  // by the sweep (advance_clock_second).
+  virtual void paired_contact_forces(double dt, PairedSweep& sweep, EvaluationTotals& first) = 0;
+  // The clock and the walls at the second step of a pair (the step count is not advanced yet).
+  virtual void advance_clock_second() = 0;
+  // commit() for the first step of a pair, with its totals and the drum's speed at its time.
+  virtual void commit_first(double dt, double late_loss, const EvaluationTotals& first,
+                            double drum_omega) = 0;
 
  protected:
   ~StepStages() = default;
@@ -149,6 +160,14 @@ class Integrator {
   // After particles were born or removed between steps and the forces evaluated anew at the
   // step's end state.
   virtual void after_population_change() {}
+  // Whether the next two steps may run in one sweep over the store (paired_step): the store is
+  // one drift ahead, no rebuild is due, and the lists stay valid through the second step with a
+  // wide margin (Verlet only).
+  virtual bool can_pair(const StepStages& /*s*/) const { return false; }
+  // The next two steps in one sweep: the same bits as two step() calls, the first not running
+  // ahead... (VelocityVerlet); the second leaves the store one drift ahead when
+  // `second_ahead`. Both steps' round verdicts, in order.
+  virtual std::pair<StepOutcome, StepOutcome> paired_step(StepStages& s, bool second_ahead);
   const PassCounter& passes() const { return passes_; }
   PassCounter& passes() { return passes_; }
 
@@ -225,12 +244,15 @@ class VelocityVerlet final : public Integrator {
   }
   void allow_run_ahead(bool allowed) override { run_ahead_allowed_ = allowed; }
   bool ran_ahead() const override { return ahead_; }
+  bool can_pair(const StepStages& s) const override;
+  std::pair<StepOutcome, StepOutcome> paired_step(StepStages& s, bool second_ahead) override;
   void step_back(ParticleStore& p) override;
   void state_replaced() override { after_population_change(); }
 
  private:
   void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
-  StepOutcome end_of_step_round(StepStages& s, const ClosingKick& c);
+  // The round: `max_overlap` the step's (totals()), and the rebuild decided for the next step.
+  StepOutcome end_of_step_round(StepStages& s, const ClosingKick& c, double max_overlap);
 
   double dt_;
   Vec2 gravity_;
@@ -239,6 +261,9 @@ class VelocityVerlet final : public Integrator {
   bool rebuild_next_ = true;        // decided by the previous step's round
   bool ghosts_ahead_ = false;       // the ghosts already hold this step's drifted state
   bool elastic_cleared_ = false;    // the owned elastic forces are zero (closing_kick)
+  // The last round's bound on the displacement since the build at the coming drift's end, and
+  // the coming drift's largest move (can_pair).
+  double bound_ = 0.0, drift_move_ = 0.0;
   // In parallel: the state the halo sources will drift to in the next step (their entries
   // only), sent to the ghosts in the end-of-step round.
   std::vector<FieldBase*> next_registry_;

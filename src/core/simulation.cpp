@@ -248,8 +248,12 @@ void Simulation::step(bool end_observed) {
                                next % kEnergyCheckSteps != 0 && next % kBackupSteps != 0);
   population_planned_ = false;
   const StepOutcome outcome = integrator_->step(*this);
+  after_step(outcome, integrator_->ran_ahead());
+}
+
+void Simulation::after_step(const StepOutcome& outcome, bool ran_ahead) {
   ++step_;
-  steps_run_ahead_ += integrator_->ran_ahead() ? 1 : 0;
+  steps_run_ahead_ += ran_ahead ? 1 : 0;
   if (outcome.unstable) report_unstable(outcome);
   if (grinding_) population_step();
   if (step_ % kEnergyCheckSteps == 0 || time_ + 0.5 * dt_ >= scene_.run.duration) check_energy();
@@ -257,6 +261,44 @@ void Simulation::step(bool end_observed) {
     backup_.save(particles_, time_, step_);
     builds_at_backup_ = contacts_.builds();
   }
+}
+
+int Simulation::advance(bool end_observed, bool second_observed) {
+  const std::int64_t next = step_ + 1, second = step_ + 2;
+  const auto last = [&](std::int64_t k) {
+    return static_cast<double>(k) * dt_ + 0.5 * dt_ >= scene_.run.duration;
+  };
+  // What step() would allow each step: running ahead (the first must, the second may).
+  const auto may_run_ahead = [&](std::int64_t k, bool observed) {
+    return run_ahead_ && !observed && !last(k) && k % kEnergyCheckSteps != 0 &&
+           k % kBackupSteps != 0;
+  };
+  const bool pair = baseline_taken_ && particles_.n_owned() >= pair_steps_from_ &&
+                    particles_.size() == particles_.n_owned() && domain_->size() == 1 &&
+                    !grinding_ && !spectra_ && may_run_ahead(next, end_observed) &&
+                    contacts_.pairs_steps() && integrator_->can_pair(*this);
+  if (!pair) {
+    step(end_observed);
+    return 1;
+  }
+  population_planned_ = false;
+  const auto [first, then] =
+      integrator_->paired_step(*this, may_run_ahead(second, second_observed));
+  steps_paired_ += 2;
+  if (first.unstable) {  // named at its own step and time, with its own totals
+    const EvaluationTotals second_totals = contacts_.totals();
+    const double t = time_;
+    time_ = static_cast<double>(next) * dt_;
+    contacts_.restore_totals(paired_first_totals_);
+    after_step(first, true);
+    contacts_.restore_totals(second_totals);
+    time_ = t;
+  } else {
+    ++step_;
+    ++steps_run_ahead_;
+  }
+  after_step(then, integrator_->ran_ahead());
+  return 2;
 }
 
 // Velocity Verlet plans the population step within the step (population_changes), the
@@ -301,9 +343,11 @@ double Simulation::local_energy() const {
 
 void Simulation::run_until(double t_end) {
   while (time_ + 0.5 * dt_ < t_end) {
-    // The loop's own test for the next step, on the time that step will set (advance_clock).
-    const bool more = static_cast<double>(step_ + 1) * dt_ + 0.5 * dt_ < t_end;
-    step(/*end_observed=*/!more);
+    // The loop's own test for the next steps, on the time they will set (advance_clock).
+    const auto ends = [&](std::int64_t k) {
+      return static_cast<double>(step_ + k) * dt_ + 0.5 * dt_ >= t_end;
+    };
+    advance(/*end_observed=*/ends(1), /*second_observed=*/ends(2));
   }
 }
 
@@ -312,6 +356,11 @@ void Simulation::run_until(double t_end) {
 
 void Simulation::advance_clock() {
   time_ = static_cast<double>(step_ + 1) * dt_;
+  walls_.update(time_);
+}
+
+void Simulation::advance_clock_second() {
+  time_ = static_cast<double>(step_ + 2) * dt_;
   walls_.update(time_);
 }
 
@@ -403,6 +452,23 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
   contacts_.evaluate(particles_, walls_, dt);
 }
 
+void Simulation::paired_contact_forces(double dt, PairedSweep& sweep, EvaluationTotals& first) {
+  contacts_.evaluate_paired(particles_, walls_, dt, sweep, first);
+  paired_first_totals_ = first;
+}
+
+void Simulation::commit_first(double dt, double late_loss, const EvaluationTotals& first,
+                              double drum_omega) {
+  contacts_.commit();
+  book(first, dt, late_loss, drum_omega);
+}
+
+void Simulation::book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega) {
+  dissipated_ += t.dissipated + late_loss;
+  drive_work_ += t.drive_power * dt;
+  drum_work_ += t.drum_torque * drum_omega * dt;
+}
+
 void Simulation::commit(double dt, double late_loss) {
   if (spectra_) {  // the spectra's tracker keeps the trial slots (Kernel::kInPlace)
     const PairList& pl = contacts_.pairs();
@@ -414,10 +480,7 @@ void Simulation::commit(double dt, double late_loss) {
                          contacts_.history_offset("peak_energy"));
   }
   contacts_.commit();
-  const EvaluationTotals& t = contacts_.totals();
-  dissipated_ += t.dissipated + late_loss;
-  drive_work_ += t.drive_power * dt;
-  drum_work_ += t.drum_torque * walls_.drum_omega() * dt;
+  book(contacts_.totals(), dt, late_loss, walls_.drum_omega());
 }
 
 void Simulation::refresh_forces() {

@@ -96,6 +96,18 @@ class Simulation final : private StepStages {
   // ahead (the closing kick fused with the next kick-drift, the same bits; integrators.hpp).
   // The simulation itself keeps the state whole at the steps it checks or backs up.
   void step(bool end_observed = true);
+  // One step, or two in one sweep over the store when that is allowed and pays (from
+  // pair_steps_from() owned particles; one rank, Velocity Verlet, histories written in place, no
+  // ore models or collision spectra; integrators.cpp, "Two steps in one sweep"): the same bits
+  // as step() and step() again. `end_observed` as for step(), of the next step;
+  // `second_observed` of the one after. Returns the number of steps taken.
+  int advance(bool end_observed, bool second_observed);
+  // The smallest owned count at which advance() pairs steps (default kPairStepsFrom; tests
+  // lower it, 0 pairs whenever allowed; a huge value never pairs).
+  void set_pair_steps_from(std::size_t n) { pair_steps_from_ = n; }
+  std::size_t pair_steps_from() const { return pair_steps_from_; }
+  // Steps so far that ran in pairs (each step counted).
+  std::int64_t steps_paired() const { return steps_paired_; }
   // Steps until t_end; the state is whole when it returns.
   void run_until(double t_end);
   // Whether steps may run ahead at all (default on): off, every step ends whole (tests compare).
@@ -163,6 +175,14 @@ class Simulation final : private StepStages {
   PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
   bool population_changes() override;
   void commit(double dt, double late_loss) override;
+  void paired_contact_forces(double dt, PairedSweep& sweep, EvaluationTotals& first) override;
+  void advance_clock_second() override;
+  void commit_first(double dt, double late_loss, const EvaluationTotals& first,
+                    double drum_omega) override;
+  // The ledger's share of one step's totals.
+  void book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega);
+  // After a step: its count, the guard verdict, the energy check and the backup (step()).
+  void after_step(const StepOutcome& outcome, bool ran_ahead);
 
   void choose_dt();
   void set_up_lists();
@@ -219,7 +239,11 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  bool population_planned_ = false;  // this step's population step planned by the integrator
+  static constexpr std::size_t kPairStepsFrom = 50000;
+  std::size_t pair_steps_from_ = kPairStepsFrom;
+  std::int64_t steps_paired_ = 0;
+  EvaluationTotals paired_first_totals_;  // the first step's of the last pair (its guards)
+  bool population_planned_ = false;       // this step's population step planned by the integrator
   // Last known good state, saved every kBackupSteps steps and after every rebuild.
   static constexpr std::int64_t kBackupSteps = 1000;
   StateBackup backup_;
