@@ -239,7 +239,9 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  static constexpr std::size_t kPairStepsFrom = 50000;
+  // From this many owned particles advance() pairs steps: the crossover measured on the deposited
+  // beds (docs/performance.md, eleventh session: 0.93 of the time at 1e5, 1.07 at 3e4).
+  static constexpr std::size_t kPairStepsFrom = 100000;
   std::size_t pair_steps_from_ = kPairStepsFrom;
   std::int64_t steps_paired_ = 0;
   EvaluationTotals paired_first_totals_;  // the first step's of the last pair (its guards)

@@ -109,5 +109,68 @@ TEST(PairedSteps, TheThesisLawEndsBitForBitAsStepByStep) {
   expect_pairs_change_nothing(s, {0.05, 0.13});
 }
 
+// A pile of soft balls in a slow drum overlaps past a quarter of a radius as it settles: the
+// overlap guard fires. Where the guard fires at the first step of a pair it must name that
+// step, at its time, with its overlap, as the run stepped one step at a time does; with
+// run.guards = "warn" both runs go on and end alike, with "stop" both stop with the same
+// error. Three stiffnesses; at least one fires within a pair's first step.
+std::string guard_of_stopped_run(Scene s, std::size_t pair_from) {
+  s.run.guards_warn = false;
+  Simulation sim(s);
+  sim.set_pair_steps_from(pair_from);
+  try {
+    for (int k = 0; k < 4000; ++k) sim.advance(false, false);
+  } catch (const UnstableError& e) {
+    return std::to_string(e.step()) + ": " + e.what();
+  }
+  return "";
+}
+
+TEST(PairedSteps, AGuardThatFiresInAPairNamesItsStepAsStepByStep) {
+  int fired_first = 0;
+  for (const double young : {3e4, 4e4, 6e4, 1e5, 1.5e5, 2e5, 3e5, 5e5}) {
+    SCOPED_TRACE(testing::Message() << "E = " << young);
+    Scene s = thesis_drum_scene(200, 0.5, 0, 0.1);
+    s.contact.model = ContactModelKind::kHertzMindlin;
+    s.contact.rolling = RollingModelKind::kEpsd;
+    s.materials.front().youngs_modulus = young;
+    s.materials.front().shear_modulus = young / 2.5;
+    s.run.guards_warn = true;
+    s.run.duration = 100.0;
+    s.run.skin = 0.4;  // wide: the falling balls' steps pair too
+    Simulation single(s), paired(s);
+    single.set_pair_steps_from(kNever);
+    paired.set_pair_steps_from(0);
+    std::int64_t until = 60;  // a few steps past the first guard (then the balls leave)
+    while (paired.step_count() < until) {
+      const std::int64_t before = paired.step_count();
+      const bool quiet = paired.guard_records().empty();
+      const int taken = paired.advance(false, false);
+      if (quiet && !paired.guard_records().empty() && taken == 2 &&
+          paired.guard_records()[0].first.find("at step " + std::to_string(before + 1) + " ") !=
+              std::string::npos)
+        ++fired_first;
+      if (quiet && !paired.guard_records().empty()) until = paired.step_count() + 3;
+    }
+    while (single.step_count() < paired.step_count()) single.advance(false, false);
+    ASSERT_EQ(single.step_count(), paired.step_count());
+    ASSERT_FALSE(single.guard_records().empty());
+    ASSERT_EQ(paired.guard_records().size(), single.guard_records().size());
+    for (std::size_t g = 0; g < single.guard_records().size(); ++g) {
+      EXPECT_EQ(paired.guard_records()[g].kind, single.guard_records()[g].kind);
+      EXPECT_EQ(paired.guard_records()[g].count, single.guard_records()[g].count);
+      EXPECT_EQ(paired.guard_records()[g].first, single.guard_records()[g].first);
+    }
+    single.run_until(single.time() + 0.5 * single.dt());  // ends whole
+    paired.run_until(paired.time() + 0.5 * paired.dt());
+    expect_same_particles(single, paired);
+    EXPECT_GT(paired.steps_paired(), 0);
+    const std::string stopped = guard_of_stopped_run(s, kNever);
+    EXPECT_FALSE(stopped.empty());
+    EXPECT_EQ(guard_of_stopped_run(s, 0), stopped);
+  }
+  EXPECT_GE(fired_first, 1) << "no guard fired at the first step of a pair";
+}
+
 }  // namespace
 }  // namespace dem2d
