@@ -9,7 +9,6 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
-#include <random>
 #include <set>
 
 #include "core/contact_kernel.hpp"
@@ -111,20 +110,7 @@ TEST(SpatialOrder, SortingChangesNoBitWhileOreBreaksIsFedAndSieved) {
 TEST(SpatialOrder, SortingChangesNoBitOfAChargePastTheCaches) {
   Scene s = thesis_drum_scene(1, 0.0, 0, 0.0);
   s.fills.clear();
-  constexpr int kSide = 230;
-  constexpr double kR = 0.004, kPitch = 2.0 * kR * (1.0 - 1e-4);
-  std::mt19937_64 draw(13);
-  std::uniform_real_distribution<double> push(-0.05, 0.05);
-  for (int row = 0; row < kSide; ++row)
-    for (int col = 0; col < kSide; ++col) {
-      ParticleSpec b;
-      b.material = "steel";
-      b.radius = kR;
-      b.position = {(col - 0.5 * (kSide - 1)) * kPitch, (row - 0.5 * (kSide - 1)) * kPitch};
-      b.velocity = {push(draw), push(draw)};
-      b.spin = 10.0 * push(draw);
-      s.particles.push_back(b);
-    }
+  testing_support::add_pushed_lattice(s, 230, 0.004, 13);
   s.run.spatial_sort = SpatialSort::kNever;
   Simulation plain(s);
   s.run.spatial_sort = SpatialSort::kAlways;

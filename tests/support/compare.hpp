@@ -36,4 +36,15 @@ inline void expect_same_particles(const Simulation& a, const Simulation& b) {
   }
 }
 
+// The energy ledger of two runs (series.csv's dissipated energy, drive work, kinetic and
+// elastic energy), bit for bit.
+inline void expect_same_ledger(const Simulation& a, const Simulation& b) {
+  const auto same = [](double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  const SeriesRow p = a.diagnostics(), q = b.diagnostics();
+  EXPECT_TRUE(same(p.dissipated_energy, q.dissipated_energy));
+  EXPECT_TRUE(same(p.drive_work, q.drive_work));
+  EXPECT_TRUE(same(p.kinetic_energy, q.kinetic_energy));
+  EXPECT_TRUE(same(p.elastic_energy, q.elastic_energy));
+}
+
 }  // namespace dem2d::testing_support

@@ -1,6 +1,7 @@
 // Shared test fixtures: the thesis's steel (seed 000, Table 1) and its drum.
 #pragma once
 
+#include <random>
 #include <string>
 
 #include "core/diagnostics.hpp"
@@ -101,6 +102,25 @@ inline Scene grinding_drum_scene() {
              .box_max = {2.5, 2.5},
              .aperture = 0.03};
   return s;
+}
+
+// A square lattice of side x side steel balls of `radius`, each touching its four neighbours
+// (pitch 2 radius (1 - 1e-4)), centred on the origin, in rows (ids row by row), pushed at
+// random: velocities up to 0.05 m/s, spins up to 0.5 rad/s.
+inline void add_pushed_lattice(Scene& s, int side, double radius, unsigned seed) {
+  const double pitch = 2.0 * radius * (1.0 - 1e-4);
+  std::mt19937_64 draw(seed);
+  std::uniform_real_distribution<double> push(-0.05, 0.05);
+  for (int row = 0; row < side; ++row)
+    for (int col = 0; col < side; ++col) {
+      ParticleSpec b;
+      b.material = "steel";
+      b.radius = radius;
+      b.position = {(col - 0.5 * (side - 1)) * pitch, (row - 0.5 * (side - 1)) * pitch};
+      b.velocity = {push(draw), push(draw)};
+      b.spin = 10.0 * push(draw);
+      s.particles.push_back(b);
+    }
 }
 
 // 200 balls of 2-20 mm radius (a 10:1 size range: four search levels) filling a 0.4 m drum of
