@@ -273,7 +273,7 @@ class Kernel final : public ContactKernel {
 // through memory: 1.7x slower per particle-step at 1e5 particles). Chunks run in list order, so
 // the scatter stays canonical.
 template <class Model>
-void Kernel<Model>::prepare_pairs(ParticleStore& p, PairList& pl) {
+void Kernel<Model>::prepare_pairs([[maybe_unused]] ParticleStore& p, PairList& pl) {
   b_.reserve(kChunk + kPackSize);
   if (bi_.size() < kChunk + kPackSize) {
     bi_.resize(kChunk + kPackSize);
