@@ -290,9 +290,18 @@ int Simulation::advance(bool end_observed, bool second_observed) {
     const double t = time_;
     time_ = static_cast<double>(next) * dt_;
     contacts_.restore_totals(paired_first_totals_);
-    after_step(first, true);
-    contacts_.restore_totals(second_totals);
-    time_ = t;
+    const auto second_step_again = [&] {
+      contacts_.restore_totals(second_totals);
+      time_ = t;
+    };
+    try {
+      after_step(first, true);
+    } catch (const UnstableError&) {  // the snapshot shows the second step's state, at its step
+      second_step_again();
+      ++step_;
+      throw;
+    }
+    second_step_again();
   } else {
     ++step_;
     ++steps_run_ahead_;

@@ -98,7 +98,8 @@ TEST(PairedSteps, TheThesisLawEndsBitForBitAsStepByStep) {
 // overlap guard fires. Where the guard fires at the first step of a pair it must name that
 // step, at its time, with its overlap, as the run stepped one step at a time does; with
 // run.guards = "warn" both runs go on and end alike, with "stop" both stop with the same
-// error. Three stiffnesses; at least one fires within a pair's first step.
+// error, and the state left for the failure snapshot carries its own step and time. Eight
+// stiffnesses; with a wide skin most fire within a pair, six in its first step.
 std::string guard_of_stopped_run(Scene s, std::size_t pair_from) {
   s.run.guards_warn = false;
   Simulation sim(s);
@@ -106,6 +107,8 @@ std::string guard_of_stopped_run(Scene s, std::size_t pair_from) {
   try {
     for (int k = 0; k < 4000; ++k) sim.advance(false, false);
   } catch (const UnstableError& e) {
+    // The state the failure snapshot shows is labelled with its own step and time.
+    EXPECT_EQ(sim.time(), static_cast<double>(sim.step_count()) * sim.dt());
     return std::to_string(e.step()) + ": " + e.what();
   }
   return "";
