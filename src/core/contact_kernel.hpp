@@ -110,7 +110,7 @@ class Kernel final : public ContactKernel {
   }
   bool histories_in_place() const override { return kInPlace; }
   std::span<const std::int32_t> breakage_tests_due() const override { return tests_due_; }
-  bool pairs_steps() const override { return kInPlace && !kFlagsTests; }
+  bool pairs_steps() const override { return kPairs; }
   void evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl, WallPairList& wl,
                        double dt, PairedSweep& sweep, EvaluationTotals& first,
                        EvaluationTotals& second) override;
@@ -240,6 +240,8 @@ class Kernel final : public ContactKernel {
   // chunks' new histories, where the grinding's scan of every entry's history after the step
   // had cost 7 % of the grinding deck's time.
   static constexpr bool kFlagsTests = std::is_same_v<typename Model::Tracker, TrackBreakage>;
+  // Two steps in one sweep (evaluate_paired): histories in place, no tests to name.
+  static constexpr bool kPairs = kInPlace && !kFlagsTests;
   std::vector<std::int32_t> tests_due_;
   // The list entries in contact in the committed histories (the only ones that can end in this
   // step), and those in contact in this evaluation (committed next). After a rebuild they are
@@ -870,7 +872,7 @@ template <class Model>
 void Kernel<Model>::evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl,
                                     WallPairList& wl, double dt, PairedSweep& sweep,
                                     EvaluationTotals& first, EvaluationTotals& second) {
-  if constexpr (!kInPlace || kFlagsTests) {
+  if constexpr (!kPairs) {
     throw std::logic_error("evaluate_paired: this contact model does not pair steps");
   } else {
     first = EvaluationTotals{};

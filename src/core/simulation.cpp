@@ -242,10 +242,7 @@ void Simulation::step(bool end_observed) {
   // step of the run (the check below, on the same figures); the ore models when they change the
   // population (the integrator asks them, population_changes). A step that rebuilds is backed up
   // too: the integrator does not run ahead after a rebuild.
-  const std::int64_t next = step_ + 1;
-  const bool last = static_cast<double>(next) * dt_ + 0.5 * dt_ >= scene_.run.duration;
-  integrator_->allow_run_ahead(run_ahead_ && !end_observed && !last &&
-                               next % kEnergyCheckSteps != 0 && next % kBackupSteps != 0);
+  integrator_->allow_run_ahead(may_run_ahead(step_ + 1, end_observed));
   population_planned_ = false;
   const StepOutcome outcome = integrator_->step(*this);
   after_step(outcome, integrator_->ran_ahead());
@@ -263,16 +260,15 @@ void Simulation::after_step(const StepOutcome& outcome, bool ran_ahead) {
   }
 }
 
+bool Simulation::may_run_ahead(std::int64_t k, bool end_observed) const {
+  const bool last = static_cast<double>(k) * dt_ + 0.5 * dt_ >= scene_.run.duration;
+  return run_ahead_ && !end_observed && !last && k % kEnergyCheckSteps != 0 &&
+         k % kBackupSteps != 0;
+}
+
 int Simulation::advance(bool end_observed, bool second_observed) {
+  // The first step of a pair must run ahead, the second may.
   const std::int64_t next = step_ + 1, second = step_ + 2;
-  const auto last = [&](std::int64_t k) {
-    return static_cast<double>(k) * dt_ + 0.5 * dt_ >= scene_.run.duration;
-  };
-  // What step() would allow each step: running ahead (the first must, the second may).
-  const auto may_run_ahead = [&](std::int64_t k, bool observed) {
-    return run_ahead_ && !observed && !last(k) && k % kEnergyCheckSteps != 0 &&
-           k % kBackupSteps != 0;
-  };
   const bool pair = baseline_taken_ && particles_.n_owned() >= pair_steps_from_ &&
                     particles_.size() == particles_.n_owned() && domain_->size() == 1 &&
                     !grinding_ && !spectra_ && may_run_ahead(next, end_observed) &&

@@ -181,6 +181,9 @@ class Simulation final : private StepStages {
                     double drum_omega) override;
   // The ledger's share of one step's totals.
   void book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega);
+  // Whether step k may leave the store one drift ahead: its end is not observed, nor the run's
+  // last, nor checked or backed up.
+  bool may_run_ahead(std::int64_t k, bool end_observed) const;
   // After a step: its count, the guard verdict, the energy check and the backup (step()).
   void after_step(const StepOutcome& outcome, bool ran_ahead);
 
