@@ -336,9 +336,6 @@ class RunLoop {
   void after_step();
   // Whether anything reads the particles after the coming step: an output or checkpoint due at
   // its time, the stop poll, the end of the run (else the step may run ahead: Simulation::step).
-  bool observes_next_step() const { return observes_step(sim_.step_count() + 1); }
-  // The same of the step after it (Simulation::advance may take both in one sweep).
-  bool observes_second_step() const { return observes_step(sim_.step_count() + 2); }
   bool observes_step(std::int64_t next) const {
     const double t = static_cast<double>(next) * sim_.dt();  // Simulation::advance_clock's
     return polls_at(next) || t + 0.5 * sim_.dt() >= scene_.run.duration || due_at(t).any();
@@ -377,7 +374,7 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
   }
   try {
     while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
-      sim_.advance(observes_next_step(), observes_second_step());
+      sim_.advance([&](int k) { return observes_step(sim_.step_count() + k); });
       after_step();
       if (polls_at(sim_.step_count()) && stop_requested()) return finish(Ending::kInterrupted);
       progress.update(sim_, n_global);

@@ -56,9 +56,9 @@ void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
   kernel_->evaluate(p, walls, pairs_, wall_pairs_, dt, totals_);
 }
 
-void ContactEngine::evaluate_paired(ParticleStore& p, const Walls& walls, double dt,
-                                    PairedSweep& sweep, EvaluationTotals& first) {
-  kernel_->evaluate_paired(p, walls, pairs_, wall_pairs_, dt, sweep, first, totals_);
+void ContactEngine::evaluate_sweep(ParticleStore& p, double dt, StepSweep& sweep,
+                                   std::span<EvaluationTotals> early) {
+  kernel_->evaluate_sweep(p, pairs_, wall_pairs_, dt, sweep, early, totals_);
 }
 
 void ContactEngine::commit() {

@@ -43,25 +43,25 @@ struct EvaluationTotals {
   std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)
 };
 
-// Velocity Verlet's two steps in one sweep over the pair list (ContactKernel::evaluate_paired,
-// VelocityVerlet::paired_step): told, as the sweep goes, that the forces of a further range of
-// the owned particles are complete, for the first step or for the second. Ranges come in order,
-// each starting where the last ended, their bounds multiples of 8 but for the last, which ends
-// at n_owned.
-class PairedSweep {
+// Velocity Verlet's steps in one sweep over the pair list (ContactKernel::evaluate_sweep,
+// VelocityVerlet::sweep_steps): the walls at each step's pose, and told, as the sweep goes, that
+// the forces of a further range of the owned particles are complete for one of the steps. Each
+// step's ranges come in order, each starting where the last ended, their bounds multiples of 8
+// but for the last, which ends at n_owned.
+class StepSweep {
  public:
-  // The first step's forces on owned particles [from, to) are complete (pairs and walls): close
-  // their step and drift them to the second step's state (their mirror lines written).
-  virtual void first_done(std::size_t from, std::size_t to) = 0;
-  // The same for the second step's forces.
-  virtual void second_done(std::size_t from, std::size_t to) = 0;
-  // The walls' contacts of the first step are evaluated: put the walls where they are at the
-  // second step.
-  virtual void walls_to_second() = 0;
+  // The walls where they are at step `step` of the sweep (0: the first).
+  virtual const Walls& walls(int step) const = 0;
+  // Step `step`'s forces on owned particles [from, to) are complete (pairs and walls): close
+  // that step and drift them to the next step's state (their mirror lines written).
+  virtual void done(int step, std::size_t from, std::size_t to) = 0;
 
  protected:
-  ~PairedSweep() = default;
+  ~StepSweep() = default;
 };
+
+// The most steps one sweep takes (ContactKernel::evaluate_sweep).
+inline constexpr int kMaxSweepSteps = 8;
 
 // The force loop for one contact model, instantiated at setup (contact_engine.cpp).
 class ContactKernel {
@@ -84,16 +84,17 @@ class ContactKernel {
   // With the breakage tracker: the pair-list entries of the last evaluation whose breakage test
   // is due (TrackBreakage::test_due of their new histories), in list order. Empty otherwise.
   virtual std::span<const std::int32_t> breakage_tests_due() const { return {}; }
-  // Whether evaluate_paired is available (histories written in place, nothing tracked).
+  // Whether evaluate_sweep is available (histories written in place, nothing tracked).
   virtual bool pairs_steps() const { return false; }
-  // Two force evaluations in one sweep over the lists, the second at the state the first step's
-  // closing kick and drift (told through `sweep`) leave: the same forces, histories and totals,
-  // bit for bit, as two evaluations with the steps between them. The pair list in canonical order
-  // and no ghosts; the walls at the first step's pose, moved by `sweep` between the two. The wall
-  // histories end where they would after two evaluations and two commits.
-  virtual void evaluate_paired(ParticleStore& /*p*/, const Walls& /*walls*/, PairList& /*pl*/,
-                               WallPairList& /*wl*/, double /*dt*/, PairedSweep& /*sweep*/,
-                               EvaluationTotals& /*first*/, EvaluationTotals& /*second*/) {}
+  // The force evaluations of early.size() + 1 steps (2 to kMaxSweepSteps) in one sweep over the
+  // lists, each at the state the step before's closing kick and drift (told through `sweep`)
+  // leave: the same forces, histories and totals, bit for bit, as that many evaluations with the
+  // steps between them. The pair list in canonical order and no ghosts; the walls at each step's
+  // pose from `sweep`. The totals of all steps but the last into `early`, the last's into
+  // `last`; the wall histories end where they would after the evaluations and their commits.
+  virtual void evaluate_sweep(ParticleStore& /*p*/, PairList& /*pl*/, WallPairList& /*wl*/,
+                              double /*dt*/, StepSweep& /*sweep*/,
+                              std::span<EvaluationTotals> /*early*/, EvaluationTotals& /*last*/) {}
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.
@@ -117,10 +118,10 @@ class ContactEngine {
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
   // See ContactKernel::histories_in_place.
   bool histories_in_place() const { return kernel_->histories_in_place(); }
-  // See ContactKernel::pairs_steps and evaluate_paired (`second` becomes totals()).
+  // See ContactKernel::pairs_steps and evaluate_sweep (the last step's totals become totals()).
   bool pairs_steps() const { return kernel_->pairs_steps() && pairs_.canonical(); }
-  void evaluate_paired(ParticleStore& p, const Walls& walls, double dt, PairedSweep& sweep,
-                       EvaluationTotals& first);
+  void evaluate_sweep(ParticleStore& p, double dt, StepSweep& sweep,
+                      std::span<EvaluationTotals> early);
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
   // The pairs' histories as the last evaluation wrote them: the committed ones when written in
@@ -131,7 +132,7 @@ class ContactEngine {
   // See ContactKernel::breakage_tests_due.
   std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }
-  // Put back the totals of an earlier evaluation (a paired step's first, for its guards).
+  // Put back the totals of an earlier evaluation (a swept step's, for its guards).
   void restore_totals(const EvaluationTotals& t) { totals_ = t; }
   // The trial histories become the committed ones.
   void commit();

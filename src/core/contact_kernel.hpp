@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <tuple>
 #include <type_traits>
@@ -111,9 +112,8 @@ class Kernel final : public ContactKernel {
   bool histories_in_place() const override { return kInPlace; }
   std::span<const std::int32_t> breakage_tests_due() const override { return tests_due_; }
   bool pairs_steps() const override { return kPairs; }
-  void evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl, WallPairList& wl,
-                       double dt, PairedSweep& sweep, EvaluationTotals& first,
-                       EvaluationTotals& second) override;
+  void evaluate_sweep(ParticleStore& p, PairList& pl, WallPairList& wl, double dt, StepSweep& sweep,
+                      std::span<EvaluationTotals> early, EvaluationTotals& last) override;
   PairKinematics* drift_mirror(const ParticleStore& p) override {
 #if DEM2D_VECTOR_GATHER
     if (vector_gather_) {
@@ -150,7 +150,7 @@ class Kernel final : public ContactKernel {
     return out;
   }
 
-  // What a pair loop adds up as it goes (pair_contacts, evaluate_paired).
+  // What a pair loop adds up as it goes (pair_contacts, evaluate_sweep).
   struct PairTotals {
     Pack dissipated{0.0}, elastic{0.0};
     double max_ratio = 0.0;
@@ -202,7 +202,7 @@ class Kernel final : public ContactKernel {
   void evaluate_walls(std::size_t n, double dt);
   void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
                      EvaluationTotals& tot);
-  // The paired sweep's wall contacts (evaluate_paired): each contact's forces and its shares of
+  // The sweep's wall contacts (evaluate_sweep): each contact's forces and its shares of
   // the totals, kept per list entry, added to the particles when their pairs are done and to the
   // totals in list order at the end: what scatter_walls adds, in its order.
   struct WallRecord {
@@ -240,7 +240,7 @@ class Kernel final : public ContactKernel {
   // chunks' new histories, where the grinding's scan of every entry's history after the step
   // had cost 7 % of the grinding deck's time.
   static constexpr bool kFlagsTests = std::is_same_v<typename Model::Tracker, TrackBreakage>;
-  // Two steps in one sweep (evaluate_paired): histories in place, no tests to name.
+  // Steps in one sweep (evaluate_sweep): histories in place, no tests to name.
   static constexpr bool kPairs = kInPlace && !kFlagsTests;
   std::vector<std::int32_t> tests_due_;
   // The list entries in contact in the committed histories (the only ones that can end in this
@@ -263,11 +263,11 @@ class Kernel final : public ContactKernel {
   };
   Array<std::uint8_t> touch_;
   Array<ForceRecord> records_;
-  // The paired sweep's plan, made again after every rebuild: per chunk the largest partner
+  // The sweep's plan, made again after every rebuild: per chunk the largest partner
   // index, and the wall entries in particle order (stable: list order within a particle).
   bool sweep_plan_stale_ = true;
   std::vector<std::int32_t> chunk_last_j_, wall_order_;
-  std::vector<WallRecord> wall_first_, wall_second_;
+  std::array<std::vector<WallRecord>, kMaxSweepSteps> wall_records_;
 };
 
 // The candidates are processed in chunks, each through phases A, B and C, so that the batch
@@ -759,7 +759,7 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
   tot.max_overlap = max_ratio;
 }
 
-// The paired sweep's wall contacts: the gathered contacts' new histories into `fresh` and their
+// The sweep's wall contacts: the gathered contacts' new histories into `fresh` and their
 // records (per list entry), with scatter_walls's expressions.
 template <class Model>
 void Kernel<Model>::record_walls(const Walls& walls, const WallPairList& wl, std::size_t n,
@@ -860,89 +860,97 @@ void Kernel<Model>::plan_sweep(const PairList& pl, const WallPairList& wl) {
   sweep_plan_stale_ = false;
 }
 
-// Two steps in one sweep (ContactKernel::evaluate_paired). The first step's chunks run in list
-// order as in pair_contacts; after each, the owned particles below the next chunk's first
-// particle (rounded down to a multiple of 8) have all their pairs: their first-step wall forces
-// are added (evaluated before the sweep, at the first pose), the sweep closes and drifts them,
-// and their second-step wall contacts are evaluated at once (the walls at the second pose). A
-// second-step chunk runs as soon as every particle it names has been drifted, and hands its
-// complete particles to the sweep the same way. Each particle's sums are the same additions in
-// the same order as in two evaluations; the totals are added in the same order too.
+// Steps in one sweep (ContactKernel::evaluate_sweep). The first step's chunks run in list order
+// as in pair_contacts; after each, the owned particles below the next chunk's first particle
+// (rounded down to a multiple of 8) have all their pairs: their first-step wall forces are added
+// (evaluated before the sweep, at the first pose), the sweep closes and drifts them, and their
+// second-step wall contacts are evaluated at once (the walls at the second pose). A chunk of a
+// later step runs as soon as every particle it names has been drifted by the step before, and
+// hands its complete particles on the same way, so each step's loop follows the one before
+// through the store. Each particle's sums are the same additions in the same order as in
+// separate evaluations; the totals are added in the same order too.
 template <class Model>
-void Kernel<Model>::evaluate_paired(ParticleStore& p, const Walls& walls, PairList& pl,
-                                    WallPairList& wl, double dt, PairedSweep& sweep,
-                                    EvaluationTotals& first, EvaluationTotals& second) {
+void Kernel<Model>::evaluate_sweep(ParticleStore& p, PairList& pl, WallPairList& wl, double dt,
+                                   StepSweep& sweep, std::span<EvaluationTotals> early,
+                                   EvaluationTotals& last) {
   if constexpr (!kPairs) {
-    throw std::logic_error("evaluate_paired: this contact model does not pair steps");
+    throw std::logic_error("evaluate_sweep: this contact model does not sweep steps");
   } else {
-    first = EvaluationTotals{};
-    second = EvaluationTotals{};
+    const int steps = static_cast<int>(early.size()) + 1;
+    if (steps < 2 || steps > kMaxSweepSteps)
+      throw std::logic_error("evaluate_sweep: 2 to kMaxSweepSteps steps");
+    const auto totals = [&](int s) -> EvaluationTotals& {
+      return s + 1 < steps ? early[static_cast<std::size_t>(s)] : last;
+    };
     if (sweep_plan_stale_) plan_sweep(pl, wl);
     const std::size_t n = p.n_owned();
-    wall_first_.assign(wl.size(), WallRecord{});
-    wall_second_.assign(wl.size(), WallRecord{});
+    for (int s = 0; s < steps; ++s) {
+      totals(s) = EvaluationTotals{};
+      wall_records_[static_cast<std::size_t>(s)].assign(wl.size(), WallRecord{});
+    }
     wb_.reserve(wl.size() + kPackSize);
-    // The first step's wall contacts, at the first pose; histories into the trial slots.
-    std::size_t nw =
-        gather_walls(p, walls, wl, nullptr, wl.size(), wl.history.data(), wl.trial.data());
-    evaluate_walls(nw, dt);
-    record_walls(walls, wl, nw, wl.trial.data(), wall_first_);
-    sweep.walls_to_second();
+    // Step s reads the wall histories from slot s % 2 and writes slot (s + 1) % 2 (the committed
+    // and the trial slots): the commit's swap after each step leaves the last one's committed.
+    double* const slot[2] = {wl.history.data(), wl.trial.data()};
+    const auto wall_step = [&](int s, const std::int32_t* entries, std::size_t count) {
+      const Walls& walls = sweep.walls(s);
+      const std::size_t m =
+          gather_walls(p, walls, wl, entries, count, slot[s % 2], slot[(s + 1) % 2]);
+      evaluate_walls(m, dt);
+      record_walls(walls, wl, m, slot[(s + 1) % 2], wall_records_[static_cast<std::size_t>(s)]);
+    };
+    wall_step(0, nullptr, wl.size());  // the first step's, at its pose, before the sweep
     prepare_pairs(p, pl);
-    PairTotals ta, tb;
+    std::array<PairTotals, kMaxSweepSteps> sums{};
+    // Per step: owned particles closed and drifted ([0, done)), the next chunk of the list, and
+    // cursors in wall_order_ (wall forces applied, wall contacts evaluated).
+    std::array<std::size_t, kMaxSweepSteps> done{}, next{}, applied{}, evaluated{};
     const std::size_t chunks = (pl.size() + kChunk - 1) / kChunk;
-    std::size_t done_a = 0, done_b = 0, next_b = 0;
-    std::size_t walls_a = 0, walls_b_evaluated = 0, walls_b = 0;  // cursors in wall_order_
     const auto complete_after = [&](std::size_t c) {
       return c + 1 < chunks ? static_cast<std::size_t>(pl.i[(c + 1) * kChunk]) & ~std::size_t{7}
                             : n;
     };
-    // The first step's hand-over of [done_a, to), then the second step's wall contacts there.
-    const auto first_done = [&](std::size_t to) {
-      apply_walls(p, wl, wall_first_, walls_a, to);
-      sweep.first_done(done_a, to);
-      const std::size_t from = walls_b_evaluated;
-      while (walls_b_evaluated < wall_order_.size() &&
-             static_cast<std::size_t>(wl.particle[wall_order_[walls_b_evaluated]]) < to)
-        ++walls_b_evaluated;
-      if (walls_b_evaluated > from) {
-        // Second step: the first step's new histories (trial) are the old ones.
-        const std::size_t m =
-            gather_walls(p, walls, wl, wall_order_.data() + from, walls_b_evaluated - from,
-                         wl.trial.data(), wl.history.data());
-        evaluate_walls(m, dt);
-        record_walls(walls, wl, m, wl.history.data(), wall_second_);
-      }
-      done_a = to;
+    // Step s's particles below `to` have all their pairs: not past the step before's hand-over (a
+    // particle without pairs is complete as soon as the step before has drifted it), their wall
+    // forces added, their step closed and drifted; then the next step's wall contacts there.
+    const auto hand_over = [&](int s, std::size_t to) {
+      const auto u = static_cast<std::size_t>(s);
+      if (s > 0) to = std::min(to, done[u - 1]);
+      if (to <= done[u]) return;
+      apply_walls(p, wl, wall_records_[u], applied[u], to);
+      sweep.done(s, done[u], to);
+      done[u] = to;
+      if (s + 1 == steps) return;
+      std::size_t& e = evaluated[u + 1];
+      const std::size_t from = e;
+      while (e < wall_order_.size() && static_cast<std::size_t>(wl.particle[wall_order_[e]]) < to)
+        ++e;
+      if (e > from) wall_step(s + 1, wall_order_.data() + from, e - from);
     };
-    // Not past the first step's hand-over: a particle without pairs is complete for the second
-    // step as soon as the first has drifted it.
-    const auto second_done = [&](std::size_t to) {
-      to = std::min(to, done_a);
-      if (to <= done_b) return;
-      apply_walls(p, wl, wall_second_, walls_b, to);
-      sweep.second_done(done_b, to);
-      done_b = to;
-    };
-    const auto second_chunks = [&](bool all) {
-      while (next_b < chunks && (all || static_cast<std::size_t>(chunk_last_j_[next_b]) < done_a)) {
-        pair_chunk(p, pl, next_b * kChunk, std::min(pl.size(), (next_b + 1) * kChunk), dt, tb);
-        second_done(complete_after(next_b++));
+    // Step s's chunks whose last partner the step before has drifted (all: every one left).
+    const auto later_chunks = [&](int s, bool all) {
+      const auto u = static_cast<std::size_t>(s);
+      while (next[u] < chunks &&
+             (all || static_cast<std::size_t>(chunk_last_j_[next[u]]) < done[u - 1])) {
+        pair_chunk(p, pl, next[u] * kChunk, std::min(pl.size(), (next[u] + 1) * kChunk), dt,
+                   sums[u]);
+        hand_over(s, complete_after(next[u]++));
       }
     };
     for (std::size_t c = 0; c < chunks; ++c) {
-      pair_chunk(p, pl, c * kChunk, std::min(pl.size(), (c + 1) * kChunk), dt, ta);
-      const std::size_t to = complete_after(c);
-      if (to > done_a) first_done(to);
-      second_chunks(false);
+      pair_chunk(p, pl, c * kChunk, std::min(pl.size(), (c + 1) * kChunk), dt, sums[0]);
+      hand_over(0, complete_after(c));
+      for (int s = 1; s < steps; ++s) later_chunks(s, false);
     }
-    if (done_a < n) first_done(n);
-    second_chunks(true);
-    if (done_b < n) second_done(n);
-    ta.into(first);
-    tb.into(second);
-    wall_totals(p, wl, wall_first_, first);
-    wall_totals(p, wl, wall_second_, second);
+    hand_over(0, n);
+    for (int s = 1; s < steps; ++s) {
+      later_chunks(s, true);
+      hand_over(s, n);
+    }
+    for (int s = 0; s < steps; ++s) {
+      sums[static_cast<std::size_t>(s)].into(totals(s));
+      wall_totals(p, wl, wall_records_[static_cast<std::size_t>(s)], totals(s));
+    }
   }
 }
 

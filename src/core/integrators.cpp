@@ -332,7 +332,7 @@ template <bool kDrift>
 // multiples of 8 but for the last, which ends at n; one range [0, n) is the whole pass): eight
 // particles per iteration over the first whole eights, with the sums' lanes 0-3 and 4-7 in two
 // registers each carried from range to range, then the rest one at a time into lane 0. Any cut
-// into such ranges gives the bits of one pass (VelocityVerlet::paired_step hands them over as
+// into such ranges gives the bits of one pass (VelocityVerlet::sweep_steps hands them over as
 // the pair loop completes them).
 template <bool kDrift>
 class ClosingRanges {
@@ -438,91 +438,105 @@ ClosingKick closing_kick_drift(ParticleStore& p, const Vec2* x_build, double dt,
 }
 
 // ---------------------------------------------------------------------------------------------
-// Two steps in one sweep
+// Steps in one sweep
 
 // Past the caches each step streams the whole store twice (the pair loop, then the closing kick
-// and drift); a pair of steps in one sweep streams it about once: the second step's pair loop
-// follows the first's a few hundred particles behind, on lines still in the cache.
+// and drift); a sweep of k steps streams it about once: each step's pair loop follows the one
+// before a few hundred particles behind, on lines still in the cache.
 //
-// The second step's evaluation uses the lists as they are, so they must hold every contact of
-// the second step's positions, which are known only as the sweep goes. The step count decides
-// to pair only with a wide margin: the last round's bound on the displacement since the build
-// at the coming drift's end, plus four times that drift's largest move for the next one, plus a
-// fiftieth of the skin, must not make a rebuild due two steps ahead. After the sweep the
-// first step's round checks the true bound (a particle would have had to speed up fourfold in
-// one step): if it fails, the run stops with an internal error rather than go on unexact.
-bool VelocityVerlet::can_pair(const StepStages& s) const {
+// A later step's evaluation uses the lists as they are, so they must hold every contact of its
+// positions, which are known only as the sweep goes. The step count decides to sweep only with a
+// wide margin: the last round's bound on the displacement since the build at the coming drift's
+// end, plus four times that drift's largest move for each further step, plus a fiftieth of the
+// skin, must not make a rebuild due at the sweep's last step. After the sweep each step's round
+// but the last checks the true bound (a particle would have had to speed up fourfold in a step):
+// if it fails, the run stops with an internal error rather than go on unexact.
+bool VelocityVerlet::can_sweep(const StepStages& s, int steps) const {
   if (!ahead_ || rebuild_next_ || ghosts_ahead_ || !elastic_cleared_) return false;
   const double skin = s.rebuilds().skin();
-  // The walls three steps on: where the first step's round will look from (paired_step).
-  return !s.rebuilds().due(bound_ + 4.0 * drift_move_ + 0.02 * skin, s.walls(), s.time(),
-                           3.0 * dt_);
+  const double further = static_cast<double>(steps - 1);
+  // The walls steps + 1 steps on: where the last early step's round will look from.
+  return !s.rebuilds().due(bound_ + 4.0 * further * drift_move_ + 0.02 * skin, s.walls(), s.time(),
+                           static_cast<double>(steps + 1) * dt_);
 }
 
 namespace {
 
-// What the kernel's sweep hands over: the first step's particles closed and drifted, the
-// second's closed (and drifted when the second step runs ahead).
-template <bool kSecondDrift>
-class PairedClosing final : public PairedSweep {
+// What the kernel's sweep hands over: a step's particles closed and drifted to the next step
+// (the last step's drifted only when it runs ahead); the walls at each step's pose, set before
+// the sweep (the clock is left at the last step).
+template <bool kLastDrift>
+class SweepClosing final : public StepSweep {
  public:
-  PairedClosing(StepStages& s, const Vec2* x_build, double dt, Vec2 gravity, PairKinematics* mirror)
-      : s_(s),
-        first_(s.particles(), x_build, dt, gravity, mirror, true),
-        second_(s.particles(), x_build, dt, gravity, kSecondDrift ? mirror : nullptr, true) {}
-  void first_done(std::size_t from, std::size_t to) override { first_.run(from, to); }
-  void second_done(std::size_t from, std::size_t to) override { second_.run(from, to); }
-  void walls_to_second() override {
-    drum_omega_ = s_.walls().drum_omega();
-    s_.advance_clock_second();
+  SweepClosing(StepStages& s, int steps, const Vec2* x_build, double dt, Vec2 gravity,
+               PairKinematics* mirror)
+      : steps_(steps),
+        last_(s.particles(), x_build, dt, gravity, kLastDrift ? mirror : nullptr, true) {
+    early_.reserve(static_cast<std::size_t>(steps - 1));
+    for (int k = 0; k < steps; ++k) {
+      if (k + 1 < steps) early_.emplace_back(s.particles(), x_build, dt, gravity, mirror, true);
+      if (k > 0) s.clock_ahead(k + 1);
+      walls_[static_cast<std::size_t>(k)] = s.walls();
+    }
   }
-  ClosingKick first() { return first_.result(); }
-  ClosingKick second() { return second_.result(); }
-  double drum_omega() const { return drum_omega_; }
+  const Walls& walls(int step) const override { return walls_[static_cast<std::size_t>(step)]; }
+  void done(int step, std::size_t from, std::size_t to) override {
+    if (step + 1 < steps_)
+      early_[static_cast<std::size_t>(step)].run(from, to);
+    else
+      last_.run(from, to);
+  }
+  ClosingKick early(int step) { return early_[static_cast<std::size_t>(step)].result(); }
+  ClosingKick last() { return last_.result(); }
 
  private:
-  StepStages& s_;
-  ClosingRanges<true> first_;
-  ClosingRanges<kSecondDrift> second_;
-  double drum_omega_ = 0.0;
+  int steps_;
+  std::vector<ClosingRanges<true>> early_;
+  ClosingRanges<kLastDrift> last_;
+  std::array<Walls, kMaxSweepSteps> walls_;
 };
 
 }  // namespace
 
-std::pair<StepOutcome, StepOutcome> Integrator::paired_step(StepStages&, bool) {
-  throw std::logic_error("paired_step: this integrator does not pair steps");
+SweepOutcomes Integrator::sweep_steps(StepStages&, int, bool) {
+  throw std::logic_error("sweep_steps: this integrator does not sweep steps");
 }
 
-std::pair<StepOutcome, StepOutcome> VelocityVerlet::paired_step(StepStages& s, bool second_ahead) {
+SweepOutcomes VelocityVerlet::sweep_steps(StepStages& s, int steps, bool last_ahead) {
   s.advance_clock();
   const Vec2* x_build = s.rebuilds().positions_at_build();
   PairKinematics* mirror = s.drift_mirror();
+  SweepOutcomes out;
   const auto run = [&](auto& sweep) {
-    EvaluationTotals first;
-    s.paired_contact_forces(dt_, sweep, first);
-    const ClosingKick a = sweep.first(), b = sweep.second();
-    s.commit_first(dt_, a.late_loss, first, sweep.drum_omega());
+    std::array<EvaluationTotals, kMaxSweepSteps - 1> early;
+    s.sweep_contact_forces(dt_, sweep,
+                           std::span(early.data(), static_cast<std::size_t>(steps - 1)));
+    for (int k = 0; k + 1 < steps; ++k) {
+      const auto u = static_cast<std::size_t>(k);
+      const ClosingKick c = sweep.early(k);
+      s.commit_early(dt_, c.late_loss, early[u], sweep.walls(k).drum_omega());
+      passes_.add(1);
+      ahead_ = true;
+      out[u] = end_of_step_round(s, c, early[u].max_overlap);
+      if (rebuild_next_ && !out[u].unstable)
+        throw std::logic_error(
+            "steps in one sweep: a later step's positions needed new neighbour lists (a "
+            "particle sped up more than the margin allows); run again with fewer particles per "
+            "rank or report this");
+    }
+    const ClosingKick c = sweep.last();
+    s.commit(dt_, c.late_loss);
     passes_.add(1);
-    ahead_ = true;
-    const StepOutcome out_a = end_of_step_round(s, a, first.max_overlap);
-    if (rebuild_next_ && !out_a.unstable)
-      throw std::logic_error(
-          "two steps in one sweep: the second step's positions needed new neighbour lists "
-          "(a particle sped up more than the margin allows); run again with fewer particles "
-          "per rank or report this");
-    s.commit(dt_, b.late_loss);
-    passes_.add(1);
-    ahead_ = second_ahead;
-    return std::pair{out_a, end_of_step_round(s, b, s.totals().max_overlap)};
+    ahead_ = last_ahead;
+    out[static_cast<std::size_t>(steps - 1)] = end_of_step_round(s, c, s.totals().max_overlap);
   };
-  std::pair<StepOutcome, StepOutcome> out;
-  if (second_ahead) {
-    PairedClosing<true> sweep(s, x_build, dt_, gravity_, mirror);
-    out = run(sweep);
-    s.drift_mirror();  // the second drift wrote the owned lines: the next fill keeps them
+  if (last_ahead) {
+    SweepClosing<true> sweep(s, steps, x_build, dt_, gravity_, mirror);
+    run(sweep);
+    s.drift_mirror();  // the last drift wrote the owned lines: the next fill keeps them
   } else {
-    PairedClosing<false> sweep(s, x_build, dt_, gravity_, mirror);
-    out = run(sweep);
+    SweepClosing<false> sweep(s, steps, x_build, dt_, gravity_, mirror);
+    run(sweep);
   }
   return out;
 }

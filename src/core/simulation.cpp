@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "core/errors.hpp"
 #include "core/fill.hpp"
@@ -266,44 +268,58 @@ bool Simulation::may_run_ahead(std::int64_t k, bool end_observed) const {
          k % kBackupSteps != 0;
 }
 
-int Simulation::advance(bool end_observed, bool second_observed) {
-  // The first step of a pair must run ahead, the second may.
-  const std::int64_t next = step_ + 1, second = step_ + 2;
-  const bool pair = baseline_taken_ && particles_.n_owned() >= pair_steps_from_ &&
-                    particles_.size() == particles_.n_owned() && domain_->size() == 1 &&
-                    !grinding_ && !spectra_ && may_run_ahead(next, end_observed) &&
-                    contacts_.pairs_steps() && integrator_->can_pair(*this);
-  if (!pair) {
-    step(end_observed);
+int Simulation::advance(const std::function<bool(int)>& observed) {
+  // Every step of a sweep but its last must run ahead; the last may.
+  const std::int64_t base = step_;
+  int steps = 1;
+  if (baseline_taken_ && particles_.n_owned() >= pair_steps_from_ &&
+      particles_.size() == particles_.n_owned() && domain_->size() == 1 && !grinding_ &&
+      !spectra_ && contacts_.pairs_steps()) {
+    while (steps < sweep_steps_ && may_run_ahead(base + steps, observed(steps))) ++steps;
+    while (steps > 1 && !integrator_->can_sweep(*this, steps)) --steps;
+  }
+  if (steps == 1) {
+    step(observed(1));
     return 1;
   }
   population_planned_ = false;
-  const auto [first, then] =
-      integrator_->paired_step(*this, may_run_ahead(second, second_observed));
-  steps_paired_ += 2;
-  if (first.unstable) {  // named at its own step and time, with its own totals
-    const EvaluationTotals second_totals = contacts_.totals();
+  const SweepOutcomes out =
+      integrator_->sweep_steps(*this, steps, may_run_ahead(base + steps, observed(steps)));
+  steps_paired_ += steps;
+  ++sweeps_of_[static_cast<std::size_t>(steps)];
+  for (int k = 0; k + 1 < steps; ++k) {
+    const SweepOutcomes::value_type& outcome = out[static_cast<std::size_t>(k)];
+    if (!outcome.unstable) {
+      ++step_;
+      ++steps_run_ahead_;
+      continue;
+    }
+    // Named at its own step and time, with its own totals.
+    const EvaluationTotals last_totals = contacts_.totals();
     const double t = time_;
-    time_ = static_cast<double>(next) * dt_;
-    contacts_.restore_totals(paired_first_totals_);
-    const auto second_step_again = [&] {
-      contacts_.restore_totals(second_totals);
+    time_ = static_cast<double>(step_ + 1) * dt_;
+    contacts_.restore_totals(sweep_totals_[static_cast<std::size_t>(k)]);
+    const auto last_step_again = [&] {
+      contacts_.restore_totals(last_totals);
       time_ = t;
     };
     try {
-      after_step(first, true);
-    } catch (const UnstableError&) {  // the snapshot shows the second step's state, at its step
-      second_step_again();
-      ++step_;
+      after_step(outcome, true);
+    } catch (const UnstableError&) {  // the snapshot shows the last step's state, at its step
+      last_step_again();
+      step_ = base + steps;
       throw;
     }
-    second_step_again();
-  } else {
-    ++step_;
-    ++steps_run_ahead_;
+    last_step_again();
   }
-  after_step(then, integrator_->ran_ahead());
-  return 2;
+  after_step(out[static_cast<std::size_t>(steps - 1)], integrator_->ran_ahead());
+  return steps;
+}
+
+void Simulation::set_sweep_steps(int steps) {
+  if (steps < 2 || steps > kMaxSweepSteps)
+    throw std::invalid_argument("set_sweep_steps: 2 to " + std::to_string(kMaxSweepSteps));
+  sweep_steps_ = steps;
 }
 
 // Velocity Verlet plans the population step within the step (population_changes), the
@@ -349,10 +365,10 @@ double Simulation::local_energy() const {
 void Simulation::run_until(double t_end) {
   while (time_ + 0.5 * dt_ < t_end) {
     // The loop's own test for the next steps, on the time they will set (advance_clock).
-    const auto ends = [&](std::int64_t k) {
+    const auto ends = [&](int k) {
       return static_cast<double>(step_ + k) * dt_ + 0.5 * dt_ >= t_end;
     };
-    advance(/*end_observed=*/ends(1), /*second_observed=*/ends(2));
+    advance(ends);
   }
 }
 
@@ -364,8 +380,8 @@ void Simulation::advance_clock() {
   walls_.update(time_);
 }
 
-void Simulation::advance_clock_second() {
-  time_ = static_cast<double>(step_ + 2) * dt_;
+void Simulation::clock_ahead(int steps) {
+  time_ = static_cast<double>(step_ + steps) * dt_;
   walls_.update(time_);
 }
 
@@ -457,15 +473,16 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
   contacts_.evaluate(particles_, walls_, dt);
 }
 
-void Simulation::paired_contact_forces(double dt, PairedSweep& sweep, EvaluationTotals& first) {
-  contacts_.evaluate_paired(particles_, walls_, dt, sweep, first);
-  paired_first_totals_ = first;
+void Simulation::sweep_contact_forces(double dt, StepSweep& sweep,
+                                      std::span<EvaluationTotals> early) {
+  contacts_.evaluate_sweep(particles_, dt, sweep, early);
+  std::copy(early.begin(), early.end(), sweep_totals_.begin());
 }
 
-void Simulation::commit_first(double dt, double late_loss, const EvaluationTotals& first,
+void Simulation::commit_early(double dt, double late_loss, const EvaluationTotals& totals,
                               double drum_omega) {
   contacts_.commit();
-  book(first, dt, late_loss, drum_omega);
+  book(totals, dt, late_loss, drum_omega);
 }
 
 void Simulation::book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega) {

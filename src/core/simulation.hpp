@@ -12,7 +12,9 @@
 // commit with the energy ledger) and the diagnostics.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -96,18 +98,24 @@ class Simulation final : private StepStages {
   // ahead (the closing kick fused with the next kick-drift, the same bits; integrators.hpp).
   // The simulation itself keeps the state whole at the steps it checks or backs up.
   void step(bool end_observed = true);
-  // One step, or two in one sweep over the store when that is allowed and pays (from
-  // pair_steps_from() owned particles; one rank, Velocity Verlet, histories written in place, no
-  // ore models or collision spectra; integrators.cpp, "Two steps in one sweep"): the same bits
-  // as step() and step() again. `end_observed` as for step(), of the next step;
-  // `second_observed` of the one after. Returns the number of steps taken.
-  int advance(bool end_observed, bool second_observed);
-  // The smallest owned count at which advance() pairs steps (default kPairStepsFrom; tests
-  // lower it, 0 pairs whenever allowed; a huge value never pairs).
+  // One step, or several in one sweep over the store when that is allowed and pays (from
+  // pair_steps_from() owned particles, at most sweep_steps(); one rank, Velocity Verlet,
+  // histories written in place, no ore models or collision spectra; integrators.cpp, "Steps in
+  // one sweep"): the same bits as step() called that many times. `observed(k)` says whether
+  // anything reads the particles at the end of the k-th step from now (k = 1: the next step; as
+  // step()'s `end_observed`); a sweep ends at the first such step. Returns the steps taken.
+  int advance(const std::function<bool(int)>& observed);
+  // The smallest owned count at which advance() sweeps steps (default kPairStepsFrom; tests
+  // lower it, 0 sweeps whenever allowed; a huge value never does).
   void set_pair_steps_from(std::size_t n) { pair_steps_from_ = n; }
   std::size_t pair_steps_from() const { return pair_steps_from_; }
-  // Steps so far that ran in pairs (each step counted).
+  // The most steps advance() takes in one sweep (2 to kMaxSweepSteps; default kSweepSteps).
+  void set_sweep_steps(int steps);
+  int sweep_steps() const { return sweep_steps_; }
+  // Steps so far that ran in sweeps of several steps (each step counted), and the sweeps of
+  // exactly `steps` steps.
   std::int64_t steps_paired() const { return steps_paired_; }
+  std::int64_t sweeps_of(int steps) const { return sweeps_of_.at(static_cast<std::size_t>(steps)); }
   // Steps until t_end; the state is whole when it returns.
   void run_until(double t_end);
   // Whether steps may run ahead at all (default on): off, every step ends whole (tests compare).
@@ -175,9 +183,10 @@ class Simulation final : private StepStages {
   PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
   bool population_changes() override;
   void commit(double dt, double late_loss) override;
-  void paired_contact_forces(double dt, PairedSweep& sweep, EvaluationTotals& first) override;
-  void advance_clock_second() override;
-  void commit_first(double dt, double late_loss, const EvaluationTotals& first,
+  void sweep_contact_forces(double dt, StepSweep& sweep,
+                            std::span<EvaluationTotals> early) override;
+  void clock_ahead(int steps) override;
+  void commit_early(double dt, double late_loss, const EvaluationTotals& totals,
                     double drum_omega) override;
   // The ledger's share of one step's totals.
   void book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega);
@@ -242,13 +251,19 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  // From this many owned particles advance() pairs steps: the crossover measured on the deposited
-  // beds (docs/performance.md, eleventh session: 0.93 of the time at 1e5, 1.07 at 3e4).
+  // From this many owned particles advance() sweeps steps: the crossover measured on the
+  // deposited beds (docs/performance.md, eleventh session: two steps 0.93 of the time at 1e5,
+  // 1.07 at 3e4), and at most four steps per sweep (twelfth session: at 1e5 three steps 0.92 of
+  // two steps' time, four 0.88, six and eight no better than four).
   static constexpr std::size_t kPairStepsFrom = 100000;
+  static constexpr int kSweepSteps = 4;
   std::size_t pair_steps_from_ = kPairStepsFrom;
+  int sweep_steps_ = kSweepSteps;
   std::int64_t steps_paired_ = 0;
-  EvaluationTotals paired_first_totals_;  // the first step's of the last pair (its guards)
-  bool population_planned_ = false;       // this step's population step planned by the integrator
+  std::array<std::int64_t, kMaxSweepSteps + 1> sweeps_of_{};
+  // The totals of the last sweep's steps but its last (their guards).
+  std::array<EvaluationTotals, kMaxSweepSteps - 1> sweep_totals_;
+  bool population_planned_ = false;  // this step's population step planned by the integrator
   // Last known good state, saved every kBackupSteps steps and after every rebuild.
   static constexpr std::int64_t kBackupSteps = 1000;
   StateBackup backup_;
