@@ -55,10 +55,6 @@ class StepSweep {
   // Step `step`'s forces on owned particles [from, to) are complete (pairs and walls): close
   // that step and drift them to the next step's state (their mirror lines written).
   virtual void done(int step, std::size_t from, std::size_t to) = 0;
-  // Where step `step`'s positions, velocities and spins are while the sweep runs: null when in
-  // the store's columns, else in the pair gather's mirror lines (core/kinematics_mirror.hpp),
-  // which alone the early steps' drifts write.
-  virtual const PairKinematics* motion(int step) const = 0;
 
  protected:
   ~StepSweep() = default;

@@ -195,11 +195,10 @@ class Kernel final : public ContactKernel {
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                      EvaluationTotals& tot);
   // Wall entries `entries[0, count)` (null: all, in list order), their histories read from `old`
-  // and rewritten into `fresh`; the particles' positions, velocities and spins from `motion`'s
-  // lines (null: the store's columns; StepSweep::motion).
+  // and rewritten into `fresh`.
   std::size_t gather_walls(const ParticleStore& p, const Walls& walls, const WallPairList& wl,
                            const std::int32_t* entries, std::size_t count, const double* old,
-                           double* fresh, const PairKinematics* motion = nullptr);
+                           double* fresh);
   void evaluate_walls(std::size_t n, double dt);
   void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
                      EvaluationTotals& tot);
@@ -627,8 +626,7 @@ void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPair
 template <class Model>
 std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& walls,
                                         const WallPairList& wl, const std::int32_t* entries,
-                                        std::size_t count, const double* old, double* fresh,
-                                        const PairKinematics* motion) {
+                                        std::size_t count, const double* old, double* fresh) {
   const Vec2* x = p.pos.data();
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
@@ -641,28 +639,25 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     const std::size_t k = entries ? static_cast<std::size_t>(entries[e_k]) : e_k;
     const std::int32_t i = wl.particle[k];
     for (std::size_t s = 0; s < W; ++s) fresh[k * W + s] = 0.0;  // the scatter rewrites contacts
-    const Vec2 xi = motion ? Vec2{motion[i].x, motion[i].y} : x[i];
-    const Vec2 vi = motion ? Vec2{motion[i].vx, motion[i].vy} : v[i];
-    const double wi = motion ? motion[i].w : w[i];
     const WallElement& e = elements[wl.element[k]];
     WallGeometry g;
     if (e.kind == WallKind::kCircle) {
       // The circle's test and geometry of Walls::touches and Walls::geometry, with the cheap
       // test's distance kept for the geometry.
       const Vec2 c = walls.circle_center(e);
-      const Vec2 d = xi - c;
+      const Vec2 d = x[i] - c;
       const double d2 = norm2(d);
       if (clear_inside_circle(e.radius, r[i], d2)) continue;
       g = circle_geometry(c, e.radius, d, std::sqrt(d2), r[i]);
     } else {
       // Most candidates do not touch: the cheap test skips the square root and division of the
       // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).
-      if (!walls.touches(wl.element[k], xi, r[i])) continue;
-      g = walls.geometry(wl.element[k], xi, r[i]);
+      if (!walls.touches(wl.element[k], x[i], r[i])) continue;
+      g = walls.geometry(wl.element[k], x[i], r[i]);
     }
     if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit
     const Vec2 vw = walls.velocity_at(e.body, g.point);
-    const Vec2 vrel = (vi - vw) + (wi * r[i]) * perp(g.n);
+    const Vec2 vrel = (v[i] - vw) + (w[i] * r[i]) * perp(g.n);
     wb_.pair[n] = static_cast<std::int32_t>(k);
     wb_.coeff[n] = mat[i] * n_mat_ + e.material;
     wb_.delta[n] = g.delta;
@@ -672,7 +667,7 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     wb_.m[n] = p.mass[i];
     wb_.vx[n] = vrel.x;
     wb_.vy[n] = vrel.y;
-    wb_.omega_rel[n] = wi - bodies[e.body].omega;
+    wb_.omega_rel[n] = w[i] - bodies[e.body].omega;
     for (std::size_t s = 0; s < W; ++s) wb_.history.old[s][n] = old[k * W + s];
     wb_.wx[n] = vw.x;
     wb_.wy[n] = vw.y;
@@ -899,8 +894,8 @@ void Kernel<Model>::evaluate_sweep(ParticleStore& p, PairList& pl, WallPairList&
     double* const slot[2] = {wl.history.data(), wl.trial.data()};
     const auto wall_step = [&](int s, const std::int32_t* entries, std::size_t count) {
       const Walls& walls = sweep.walls(s);
-      const std::size_t m = gather_walls(p, walls, wl, entries, count, slot[s % 2],
-                                         slot[(s + 1) % 2], sweep.motion(s));
+      const std::size_t m =
+          gather_walls(p, walls, wl, entries, count, slot[s % 2], slot[(s + 1) % 2]);
       evaluate_walls(m, dt);
       record_walls(walls, wl, m, slot[(s + 1) % 2], wall_records_[static_cast<std::size_t>(s)]);
     };

@@ -109,18 +109,15 @@ namespace {
 #if DEM2D_VECTOR_GATHER
 // What the drift of particles k..k+3 writes once their new state is in registers (x, v and w
 // of the four side by side): drift_one's stores, four at a time. drift_fours and close_four
-// both use it; without kColumns x, v and w go to the mirror lines only (a sweep's early steps).
-template <bool kColumns = true>
+// both use it.
 [[gnu::always_inline]] inline void store_drift4(std::size_t k, double dt, __m512d x_new,
                                                 __m512d v_half, __m256d w_new, Vec2* x, Vec2* v,
                                                 double* th, double* w, Vec2* f, double* tq,
                                                 const double* r, const double* m,
                                                 const std::int32_t* mat, PairKinematics* mirror) {
-  if constexpr (kColumns) {
-    _mm512_storeu_pd(&x[k].x, x_new);
-    _mm512_storeu_pd(&v[k].x, v_half);
-    _mm256_storeu_pd(w + k, w_new);
-  }
+  _mm512_storeu_pd(&x[k].x, x_new);
+  _mm512_storeu_pd(&v[k].x, v_half);
+  _mm256_storeu_pd(w + k, w_new);
   _mm256_storeu_pd(
       th + k, _mm256_add_pd(_mm256_loadu_pd(th + k), _mm256_mul_pd(_mm256_set1_pd(dt), w_new)));
   _mm512_storeu_pd(&f[k].x, _mm512_setzero_pd());
@@ -214,11 +211,7 @@ struct ClosingSums {
   }
 };
 
-// The columns the closing kick (and the drift) read and write; `mirror` may be null. With
-// `source` the step's x, v and w are read from those mirror lines instead of the columns (the
-// step before was an early step of a sweep); without `columns` the new x, v, w and the
-// accelerations are not stored (an early step: the mirror lines carry the state to the next
-// step, whose closing overwrites the accelerations unread).
+// The columns the closing kick (and the drift) read and write; `mirror` may be null.
 struct ClosingColumns {
   Vec2 *a, *v, *x, *f, *f_el;
   double *al, *w, *th, *tq;
@@ -226,8 +219,6 @@ struct ClosingColumns {
   const std::int32_t* mat;
   const Vec2* x_build;
   PairKinematics* mirror;
-  const PairKinematics* source = nullptr;
-  bool columns = true;
 };
 
 ClosingColumns closing_columns(ParticleStore& p, const Vec2* x_build, PairKinematics* mirror) {
@@ -295,51 +286,23 @@ struct FourMaxima {
   __m256d disp2 = _mm256_setzero_pd(), speed2 = _mm256_setzero_pd(), motion2 = _mm256_setzero_pd();
 };
 
-// The positions, velocities and spins of particles k..k+3 from their mirror lines, side by side
-// as in the columns.
-[[gnu::always_inline]] inline void load_motion4(const PairKinematics* lines, __m512d& x, __m512d& v,
-                                                __m256d& w) {
-  const __m512d l0 = _mm512_load_pd(&lines[0].x), l1 = _mm512_load_pd(&lines[1].x);
-  const __m512d l2 = _mm512_load_pd(&lines[2].x), l3 = _mm512_load_pd(&lines[3].x);
-  // (x, y) of two particles, then their (vx, vy); likewise (w, r) then (m, material).
-  const __m512i pairs = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
-  const __m512i bodies = _mm512_setr_epi64(4, 12, 5, 13, 6, 14, 7, 15);
-  const __m512d motion01 = _mm512_permutex2var_pd(l0, pairs, l1);
-  const __m512d motion23 = _mm512_permutex2var_pd(l2, pairs, l3);
-  x = _mm512_shuffle_f64x2(motion01, motion23, 0x44);
-  v = _mm512_shuffle_f64x2(motion01, motion23, 0xEE);
-  const __m128d w01 = _mm512_castpd512_pd128(_mm512_permutex2var_pd(l0, bodies, l1));
-  const __m128d w23 = _mm512_castpd512_pd128(_mm512_permutex2var_pd(l2, bodies, l3));
-  w = _mm256_insertf128_pd(_mm256_castpd128_pd256(w01), w23, 1);
-}
-
 // close_one (and with kDrift drift_one) of particles k..k+3: the same operations in the same
-// order (no FMA); their shares of the sums into `checksum` and `late` (their lanes). kFromLines
-// and kColumns: ClosingColumns::source and ::columns.
-template <bool kDrift, bool kFromLines = false, bool kColumns = true>
+// order (no FMA); their shares of the sums into `checksum` and `late` (their lanes).
+template <bool kDrift>
 [[gnu::always_inline]] inline void close_four(std::size_t k, double h, double dt, Vec2 g,
                                               const ClosingColumns& c, FourMaxima& most,
                                               __m256d& checksum, __m256d& late) {
-  static_assert(kDrift || kColumns, "a closing kick without a drift stores its state");
   const __m512d F = _mm512_loadu_pd(&c.f[k].x);
   const __m256d T = _mm256_loadu_pd(c.tq + k);
   const __m512d A = _mm512_add_pd(_mm512_mul_pd(twice(c.inv_m + k), F),
                                   _mm512_setr_pd(g.x, g.y, g.x, g.y, g.x, g.y, g.x, g.y));
   const __m256d AL = _mm256_mul_pd(_mm256_loadu_pd(c.inv_i + k), T);
-  __m512d X, V0;
-  __m256d W0;
-  if constexpr (kFromLines) {
-    load_motion4(c.source + k, X, V0, W0);
-  } else {
-    X = _mm512_loadu_pd(&c.x[k].x);
-    V0 = _mm512_loadu_pd(&c.v[k].x);
-    W0 = _mm256_loadu_pd(c.w + k);
-  }
+  const __m512d X = _mm512_loadu_pd(&c.x[k].x);
   checksum = _mm256_add_pd(checksum, _mm256_add_pd(_mm256_add_pd(pair_sums(A), AL), pair_sums(X)));
   const __m512d hA = _mm512_mul_pd(_mm512_set1_pd(h), A);
   const __m256d hAL = _mm256_mul_pd(_mm256_set1_pd(h), AL);
-  const __m512d V = _mm512_add_pd(V0, hA);
-  const __m256d W = _mm256_add_pd(W0, hAL);
+  const __m512d V = _mm512_add_pd(_mm512_loadu_pd(&c.v[k].x), hA);
+  const __m256d W = _mm256_add_pd(_mm256_loadu_pd(c.w + k), hAL);
   const __m512d G = _mm512_sub_pd(F, _mm512_loadu_pd(&c.f_el[k].x));
   late = _mm256_add_pd(late, _mm256_add_pd(pair_sums(_mm512_mul_pd(G, hA)), _mm256_mul_pd(T, hAL)));
   const __m512d D = _mm512_sub_pd(X, _mm512_loadu_pd(&c.x_build[k].x));
@@ -350,20 +313,17 @@ template <bool kDrift, bool kFromLines = false, bool kColumns = true>
   most.disp2 = keep_larger(most.disp2, pair_sums(_mm512_mul_pd(D, D)));
   most.speed2 = keep_larger(most.speed2, s2);
   most.motion2 = keep_larger(most.motion2, _mm256_div_pd(s2, _mm256_mul_pd(rk, rk)));
-  if constexpr (kColumns) {
-    _mm512_storeu_pd(&c.a[k].x, A);
-    _mm256_storeu_pd(c.al + k, AL);
-  }
+  _mm512_storeu_pd(&c.a[k].x, A);
+  _mm256_storeu_pd(c.al + k, AL);
   _mm512_storeu_pd(&c.f_el[k].x, _mm512_setzero_pd());
   if constexpr (!kDrift) {
-    if constexpr (kFromLines) _mm512_storeu_pd(&c.x[k].x, X);
     _mm512_storeu_pd(&c.v[k].x, V);
     _mm256_storeu_pd(c.w + k, W);
     return;
   }
   const __m512d X_new = _mm512_add_pd(X, _mm512_mul_pd(_mm512_set1_pd(dt), V_half));
-  store_drift4<kColumns>(k, dt, X_new, V_half, _mm256_add_pd(W, hAL), c.x, c.v, c.th, c.w, c.f,
-                         c.tq, c.r, c.m, c.mat, c.mirror);
+  store_drift4(k, dt, X_new, V_half, _mm256_add_pd(W, hAL), c.x, c.v, c.th, c.w, c.f, c.tq, c.r,
+               c.m, c.mat, c.mirror);
 }
 
 #endif
@@ -377,11 +337,8 @@ template <bool kDrift, bool kFromLines = false, bool kColumns = true>
 template <bool kDrift>
 class ClosingRanges {
  public:
-  // `source` and `columns`: ClosingColumns; a pass that does not store the columns needs the
-  // four-at-a-time path and a mirror to write.
   ClosingRanges(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
-                PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time,
-                const PairKinematics* source = nullptr, bool columns = true)
+                PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time)
       : c_(closing_columns(p, x_build, mirror)),
         h_(0.5 * dt),
         dt_(dt),
@@ -390,13 +347,6 @@ class ClosingRanges {
         whole_(n_ / kSumLanes * kSumLanes) {
 #if DEM2D_VECTOR_GATHER
     fours_ = four_at_a_time;
-    c_.source = source;
-    c_.columns = columns;
-    if (!columns && (!fours_ || !mirror))
-      throw std::logic_error("ClosingRanges: a pass without columns writes the mirror lines");
-#else
-    if (source || !columns)
-      throw std::logic_error("ClosingRanges: mirror lines need the vector gather");
 #endif
   }
   void run(std::size_t from, std::size_t to) {
@@ -408,22 +358,9 @@ class ClosingRanges {
       __m256d checksum0 = checksum_[0], checksum1 = checksum_[1];
       __m256d late0 = late_[0], late1 = late_[1];
       const std::size_t end = std::min(to, whole_);
-      const auto eights = [&]<bool kFromLines, bool kColumns>() {
-        for (; k < end; k += 8) {
-          close_four<kDrift, kFromLines, kColumns>(k, h_, dt_, g_, c, most, checksum0, late0);
-          close_four<kDrift, kFromLines, kColumns>(k + 4, h_, dt_, g_, c, most, checksum1, late1);
-        }
-      };
-      if constexpr (kDrift) {
-        if (c.source)
-          c.columns ? eights.template operator()<true, true>()
-                    : eights.template operator()<true, false>();
-        else
-          c.columns ? eights.template operator()<false, true>()
-                    : eights.template operator()<false, false>();
-      } else {
-        c.source ? eights.template operator()<true, true>()
-                 : eights.template operator()<false, true>();
+      for (; k < end; k += 8) {
+        close_four<kDrift>(k, h_, dt_, g_, c, most, checksum0, late0);
+        close_four<kDrift>(k + 4, h_, dt_, g_, c, most, checksum1, late1);
       }
       most_ = most;
       checksum_[0] = checksum0;
@@ -435,12 +372,6 @@ class ClosingRanges {
 #endif
     const ClosingColumns c = c_;
     for (; k < to; ++k) {
-      if (c.source) {  // the columns first brought up to the lines (then written as usual)
-        const PairKinematics& l = c.source[k];
-        c.x[k] = {l.x, l.y};
-        c.v[k] = {l.vx, l.vy};
-        c.w[k] = l.w;
-      }
       close_one(k, sum_lane(k, whole_), h_, g_, c, sums_);
       if constexpr (kDrift)
         drift_one(k, h_, dt_, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
@@ -540,15 +471,10 @@ class SweepClosing final : public StepSweep {
   SweepClosing(StepStages& s, int steps, const Vec2* x_build, double dt, Vec2 gravity,
                PairKinematics* mirror)
       : steps_(steps),
-        mirror_(mirror),
-        last_(s.particles(), x_build, dt, gravity, kLastDrift ? mirror : nullptr, true, mirror) {
+        last_(s.particles(), x_build, dt, gravity, kLastDrift ? mirror : nullptr, true) {
     early_.reserve(static_cast<std::size_t>(steps - 1));
     for (int k = 0; k < steps; ++k) {
-      // With the mirror, the early steps' state goes on in the lines alone and the last step
-      // writes the columns again (fewer streams for each step's front through the store).
-      if (k + 1 < steps)
-        early_.emplace_back(s.particles(), x_build, dt, gravity, mirror, true,
-                            k > 0 ? mirror : nullptr, mirror == nullptr);
+      if (k + 1 < steps) early_.emplace_back(s.particles(), x_build, dt, gravity, mirror, true);
       if (k > 0) s.clock_ahead(k + 1);
       walls_[static_cast<std::size_t>(k)] = s.walls();
     }
@@ -560,13 +486,11 @@ class SweepClosing final : public StepSweep {
     else
       last_.run(from, to);
   }
-  const PairKinematics* motion(int step) const override { return step > 0 ? mirror_ : nullptr; }
   ClosingKick early(int step) { return early_[static_cast<std::size_t>(step)].result(); }
   ClosingKick last() { return last_.result(); }
 
  private:
   int steps_;
-  const PairKinematics* mirror_;
   std::vector<ClosingRanges<true>> early_;
   ClosingRanges<kLastDrift> last_;
   std::array<Walls, kMaxSweepSteps> walls_;
