@@ -251,12 +251,13 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  // From this many owned particles advance() sweeps steps: the crossover measured on the
-  // deposited beds (docs/performance.md, eleventh session: two steps 0.93 of the time at 1e5,
-  // 1.07 at 3e4), and at most four steps per sweep (twelfth session: at 1e5 three steps 0.92 of
-  // two steps' time, four 0.88, six and eight no better than four).
+  // From this many owned particles advance() sweeps steps, at most eight per sweep: measured on
+  // the deposited beds in interleaved blocks of one process (docs/performance.md, thirteenth
+  // session): at 1e5 and 1e6 eight steps take 0.94-0.95 of four steps' time; at 3e4 sweeps of
+  // eight 0.83-0.89 of single steps' time when the host's caches are contended and about the same
+  // when not; at 1e4 1.07.
   static constexpr std::size_t kPairStepsFrom = 100000;
-  static constexpr int kSweepSteps = 4;
+  static constexpr int kSweepSteps = 8;
   std::size_t pair_steps_from_ = kPairStepsFrom;
   int sweep_steps_ = kSweepSteps;
   std::int64_t steps_paired_ = 0;
