@@ -251,11 +251,11 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  // From this many owned particles advance() sweeps steps, at most eight per sweep: measured on
-  // the deposited beds in interleaved blocks of one process (docs/performance.md, thirteenth
-  // session): at 1e5 and 1e6 eight steps take 0.94-0.95 of four steps' time; at 3e4 sweeps of
-  // eight 0.83-0.89 of single steps' time when the host's caches are contended and about the same
-  // when not; at 1e4 1.07.
+  // From this many owned particles advance() sweeps steps, at most eight per sweep, measured in
+  // interleaved blocks of one process (bench/sweep_modes; docs/performance.md, thirteenth
+  // session): on the deposited 1e5 bed eight steps take 0.93 of four steps' time. Below 1e5
+  // sweeps win only while the host's caches are contended (the dense 3e4 bed: 0.83-1.05 of
+  // single steps' time, 1e4: 1.06) and lose on a sparse 40 000-ball waterfall (1.08-1.21).
   static constexpr std::size_t kPairStepsFrom = 100000;
   static constexpr int kSweepSteps = 8;
   std::size_t pair_steps_from_ = kPairStepsFrom;
