@@ -25,15 +25,21 @@ constexpr std::size_t kNever = std::numeric_limits<std::size_t>::max();
 
 bool never(int) { return false; }
 
-// Both runs to each time in `times`, one in sweeps of up to `sweep` steps whenever allowed, one a
-// step at a time.
+// The program's own number of steps per sweep (Simulation::sweep_steps unset).
+constexpr int kProgramsSweep = 0;
+
+// Both runs to each time in `times`, one in sweeps of up to `sweep` steps (kProgramsSweep: the
+// program's default) whenever allowed, one a step at a time.
 void expect_sweeps_change_nothing(const Scene& scene, std::initializer_list<double> times,
                                   int sweep, std::int64_t min_builds = 4) {
-  SCOPED_TRACE(testing::Message() << "up to " << sweep << " steps per sweep");
   Simulation single(scene), paired(scene);
   single.set_pair_steps_from(kNever);
   paired.set_pair_steps_from(0);
-  paired.set_sweep_steps(sweep);
+  if (sweep == kProgramsSweep)
+    sweep = paired.sweep_steps();
+  else
+    paired.set_sweep_steps(sweep);
+  SCOPED_TRACE(testing::Message() << "up to " << sweep << " steps per sweep");
   for (const double t : times) {
     SCOPED_TRACE(testing::Message() << "t = " << t);
     single.run_until(t);
@@ -70,7 +76,8 @@ TEST(PairedSteps, HertzMindlinWithRollingEndsBitForBitAsStepByStep) {
   s.contact.rolling = RollingModelKind::kEpsd;
   s.fills.front().radius_min = 0.05;
   s.fills.front().radius_max = 0.08;
-  for (const int sweep : {2, 3, 4}) expect_sweeps_change_nothing(s, {0.05, 0.1234, 0.2}, sweep);
+  for (const int sweep : {2, 3, 4, kProgramsSweep})
+    expect_sweeps_change_nothing(s, {0.05, 0.1234, 0.2}, sweep);
 }
 
 // A square lattice of 4 900 touching balls of 4 mm, pushed at random, in a circular drum that
@@ -100,7 +107,8 @@ TEST(PairedSteps, TheThesisLawEndsBitForBitAsStepByStep) {
   s.contact.rolling = RollingModelKind::kNone;
   s.fills.front().radius_min = s.fills.front().radius_max = 0.06;
   s.run.guards_warn = true;  // this law creates energy in a drum (test_pair_gather.cpp)
-  for (const int sweep : {2, 3}) expect_sweeps_change_nothing(s, {0.05, 0.13}, sweep);
+  for (const int sweep : {2, 3, kProgramsSweep})
+    expect_sweeps_change_nothing(s, {0.05, 0.13}, sweep);
 }
 
 // A pile of soft balls in a slow drum overlaps past a quarter of a radius as it settles: the
