@@ -55,6 +55,7 @@
 
 #include "core/simulation.hpp"
 #include "io/deck.hpp"
+#include "lists.hpp"
 #include "parallel/mpi_domain.hpp"
 #include "settled_drum.hpp"
 
@@ -340,21 +341,13 @@ void merge_csv(const std::string& path, const std::vector<Row>& rows) {
   for (const std::string& l : keep) out << l << "\n";
 }
 
-std::vector<std::int64_t> parse_list(const std::string& s) {
-  std::vector<std::int64_t> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(static_cast<std::int64_t>(std::stod(item)));
-  return out;
-}
-
 // Returns false on a bad command line.
 bool parse(int argc, char** argv, Args& a) {
   for (int k = 1; k < argc; ++k) {
     const std::string s = argv[k];
     const auto next = [&]() -> std::string { return k + 1 < argc ? argv[++k] : ""; };
     if (s == "--particles")
-      a.particles = parse_list(next());
+      a.particles = bench::parse_list<std::int64_t>(next());
     else if (s == "--packing")
       a.packing = next();
     else if (s == "--steps")

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "core/simulation.hpp"
+#include "lists.hpp"
 #include "settled_drum.hpp"
 
 namespace {
@@ -47,17 +48,6 @@ struct Options {
   std::string csv = "sweep_modes.csv";
   bool plot = true;
 };
-
-std::vector<int> parse_modes(const std::string& s) {
-  std::vector<int> out;
-  std::size_t at = 0;
-  while (at <= s.size()) {
-    const std::size_t comma = std::min(s.find(',', at), s.size());
-    out.push_back(std::stoi(s.substr(at, comma - at)));
-    at = comma + 1;
-  }
-  return out;
-}
 
 int usage() {
   std::fprintf(stderr,
@@ -85,7 +75,7 @@ int main(int argc, char** argv) {
       if (a == "--particles")
         o.n = std::stoll(value());
       else if (a == "--modes")
-        o.modes = parse_modes(value());
+        o.modes = bench::parse_list<int>(value());
       else if (a == "--rounds")
         o.rounds = std::stoi(value());
       else if (a == "--block-steps")
@@ -100,7 +90,8 @@ int main(int argc, char** argv) {
         return usage();
     }
     for (const int m : o.modes)
-      if (m < 1 || m > dem2d::kMaxSweepSteps) throw std::invalid_argument("modes: 1 to 8");
+      if (m < 1 || m > dem2d::kMaxSweepSteps)
+        throw std::invalid_argument("--modes: 1 to " + std::to_string(dem2d::kMaxSweepSteps));
     if (o.n < 100 || o.rounds < 2 || o.modes.empty() || o.block_steps < 0)
       throw std::invalid_argument("--particles >= 100, --rounds >= 2, --block-steps >= 0");
   } catch (const std::exception& e) {
@@ -133,7 +124,6 @@ int main(int argc, char** argv) {
       ns[m].push_back(1e9 * (thread_cpu_seconds() - t0) / (n * o.block_steps));
     }
   }
-  sim.set_pair_steps_from(static_cast<std::size_t>(1) << 40);
 
   std::printf(
       "sweep_modes: %lld particles (deposited bed, %.2f contacts per particle), %d rounds "

@@ -106,6 +106,7 @@
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
 #include "io/deck.hpp"
+#include "lists.hpp"
 #include "settled_drum.hpp"
 
 namespace {
@@ -488,16 +489,6 @@ int run_profile(const Options& opt) {
   return 0;
 }
 
-template <class T>
-std::vector<T> parse_list(const std::string& s) {
-  std::vector<T> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(static_cast<T>(std::stod(item)));
-  return out;
-}
-
 [[noreturn]] void usage(int code) {
   std::fprintf(
       code ? stderr : stdout,
@@ -539,10 +530,10 @@ Options parse(int argc, char** argv) {
         o.sections.push_back(s);
       }
     } else if (a == "--particles") {
-      o.particles = parse_list<std::int64_t>(value());
+      o.particles = bench::parse_list<std::int64_t>(value());
       particles_given = true;
     } else if (a == "--deposited") {
-      o.deposited = parse_list<std::int64_t>(value());
+      o.deposited = bench::parse_list<std::int64_t>(value());
       deposited_given = true;
     } else if (a == "--pair-steps-from") {
       o.pair_steps_from = std::stoll(value());
@@ -551,9 +542,9 @@ Options parse(int argc, char** argv) {
     } else if (a == "--deposited-speed") {
       o.deposited_speed = std::stod(value());
     } else if (a == "--order-particles") {
-      o.order_particles = parse_list<std::int64_t>(value());
+      o.order_particles = bench::parse_list<std::int64_t>(value());
     } else if (a == "--ratios") {
-      o.ratios = parse_list<double>(value());
+      o.ratios = bench::parse_list<double>(value());
     } else if (a == "--ratio-particles") {
       o.ratio_particles = static_cast<std::int64_t>(std::stod(value()));
       ratio_n_given = true;
