@@ -18,8 +18,6 @@
 // least 8). Writes DIR/NAME (default bench/results/sweep_modes.csv: round, mode, ns per
 // particle-step, ratio to the first mode) and a box plot beside it (post/plot_sweep_modes.py).
 // The bed must be in DIR/cache or is deposited and loaded first (minutes at 1e5, an hour at 1e6).
-#include <time.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -27,17 +25,12 @@
 #include <string>
 #include <vector>
 
+#include "blocks.hpp"
 #include "core/simulation.hpp"
 #include "lists.hpp"
 #include "settled_drum.hpp"
 
 namespace {
-
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 struct Options {
   std::int64_t n = 100000;
@@ -54,11 +47,6 @@ int usage() {
                "usage: sweep_modes [--particles N] [--modes 1,4,8] [--rounds R] [--block-steps S]\n"
                "                   [--results DIR] [--csv NAME] [--no-plot]\n");
   return 2;
-}
-
-double quantile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5)];
 }
 
 }  // namespace
@@ -102,7 +90,8 @@ int main(int argc, char** argv) {
     o.block_steps = std::max<int>(8, static_cast<int>((1600000 / o.n + 7) / 8 * 8));
 
   const bench::Packing pk = bench::deposited_packing(o.n, o.results + "/cache");
-  const dem2d::Scene scene = bench::settled_scene(pk, 1.0e-6);  // the drum still, as deposited
+  dem2d::Scene scene = bench::settled_scene(pk, 1.0e-6);
+  scene.drum.speed = 0.0;  // the drum still, as deposited
   dem2d::Simulation sim(scene);
   for (int k = 0; k < 50; ++k) sim.step(/*end_observed=*/k + 1 == 50);
 
@@ -118,10 +107,10 @@ int main(int argc, char** argv) {
         sim.set_pair_steps_from(0);
         sim.set_sweep_steps(o.modes[m]);
       }
-      const double t0 = thread_cpu_seconds();
+      const double t0 = bench::thread_cpu_seconds();
       for (int k = 0; k < o.block_steps;)
         k += sim.advance([&](int j) { return k + j == o.block_steps; });
-      ns[m].push_back(1e9 * (thread_cpu_seconds() - t0) / (n * o.block_steps));
+      ns[m].push_back(1e9 * (bench::thread_cpu_seconds() - t0) / (n * o.block_steps));
     }
   }
 
@@ -143,9 +132,9 @@ int main(int argc, char** argv) {
       csv << o.n << ',' << o.modes[m] << ',' << r + 1 << ',' << ns[m][u] << ',' << ratio.back()
           << '\n';
     }
-    std::printf("%-6d %10.2f %10.2f   %.3f (%.3f-%.3f)\n", o.modes[m], quantile(ns[m], 0.5),
-                quantile(ns[m], 0.0), quantile(ratio, 0.5), quantile(ratio, 0.25),
-                quantile(ratio, 0.75));
+    std::printf("%-6d %10.2f %10.2f   %.3f (%.3f-%.3f)\n", o.modes[m], bench::quantile(ns[m], 0.5),
+                bench::quantile(ns[m], 0.0), bench::quantile(ratio, 0.5),
+                bench::quantile(ratio, 0.25), bench::quantile(ratio, 0.75));
   }
   csv.close();
   std::printf(
