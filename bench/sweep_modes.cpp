@@ -6,6 +6,8 @@
 // mode 1 steps one step at a time, mode K sweeps up to K steps (Simulation::set_sweep_steps). All
 // modes give the same bits (test_core PairedSteps.*), so they can share one run: every mode sees
 // the same bed, and a slow minute of the host falls on neighbouring blocks of every mode alike.
+// Mode 0 is the program's own timed choice (core/sweep_choice.hpp), which keeps its state from
+// block to block: with it in the list every mode steps its own copy of the bed instead.
 // Each block's thread CPU time per particle-step is compared with the first mode's block of the
 // same round; the table gives the median of those ratios and its quartiles. Runs in separate
 // processes moved by up to 20 % from one to the next on this machine (docs/performance.md), which
@@ -22,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -78,8 +81,8 @@ int main(int argc, char** argv) {
         return usage();
     }
     for (const int m : o.modes)
-      if (m < 1 || m > dem2d::kMaxSweepSteps)
-        throw std::invalid_argument("--modes: 1 to " + std::to_string(dem2d::kMaxSweepSteps));
+      if (m < 0 || m > dem2d::kMaxSweepSteps)
+        throw std::invalid_argument("--modes: 0 to " + std::to_string(dem2d::kMaxSweepSteps));
     if (o.n < 100 || o.rounds < 2 || o.modes.empty() || o.block_steps < 0)
       throw std::invalid_argument("--particles >= 100, --rounds >= 2, --block-steps >= 0");
   } catch (const std::exception& e) {
@@ -92,21 +95,33 @@ int main(int argc, char** argv) {
   const bench::Packing pk = bench::deposited_packing(o.n, o.results + "/cache");
   dem2d::Scene scene = bench::settled_scene(pk, 1.0e-6);
   scene.drum.speed = 0.0;  // the drum still, as deposited
-  dem2d::Simulation sim(scene);
-  for (int k = 0; k < 50; ++k) sim.step(/*end_observed=*/k + 1 == 50);
-
+  // Mode 0, the program's timed choice, keeps its state from block to block: with it every mode
+  // steps its own copy of the bed (all copies hold the same bits after each round).
+  const bool own_beds = std::find(o.modes.begin(), o.modes.end(), 0) != o.modes.end();
   const std::size_t nm = o.modes.size();
+  std::vector<std::unique_ptr<dem2d::Simulation>> sims;
+  for (std::size_t m = 0; m < (own_beds ? nm : 1); ++m) {
+    sims.push_back(std::make_unique<dem2d::Simulation>(scene));
+    for (int k = 0; k < 50; ++k) sims.back()->step(/*end_observed=*/k + 1 == 50);
+  }
+  const auto set_mode = [&](dem2d::Simulation& sim, int mode) {
+    if (mode == 1) {
+      sim.set_pair_steps_from(static_cast<std::size_t>(1) << 40);
+    } else if (mode > 1) {
+      sim.set_pair_steps_from(0);
+      sim.set_sweep_steps(mode);
+    }  // 0: as constructed
+  };
+  if (own_beds)
+    for (std::size_t m = 0; m < nm; ++m) set_mode(*sims[m], o.modes[m]);
+
   std::vector<std::vector<double>> ns(nm);
   const auto n = static_cast<double>(o.n);
   for (int r = 0; r < o.rounds; ++r) {
     for (std::size_t q = 0; q < nm; ++q) {
       const std::size_t m = (q + static_cast<std::size_t>(r)) % nm;
-      if (o.modes[m] == 1) {
-        sim.set_pair_steps_from(static_cast<std::size_t>(1) << 40);
-      } else {
-        sim.set_pair_steps_from(0);
-        sim.set_sweep_steps(o.modes[m]);
-      }
+      dem2d::Simulation& sim = own_beds ? *sims[m] : *sims[0];
+      if (!own_beds) set_mode(sim, o.modes[m]);
       const double t0 = bench::thread_cpu_seconds();
       for (int k = 0; k < o.block_steps;)
         k += sim.advance([&](int j) { return k + j == o.block_steps; });
@@ -117,8 +132,8 @@ int main(int argc, char** argv) {
   std::printf(
       "sweep_modes: %lld particles (deposited bed, %.2f contacts per particle), %d rounds "
       "of %d-step blocks per mode\n",
-      static_cast<long long>(o.n), static_cast<double>(sim.last_totals().contacts) / n, o.rounds,
-      o.block_steps);
+      static_cast<long long>(o.n), static_cast<double>(sims[0]->last_totals().contacts) / n,
+      o.rounds, o.block_steps);
   std::printf("%-6s %10s %10s   over mode %d in its round: median (quartiles)\n", "mode",
               "ns median", "ns min", o.modes[0]);
   const std::string path = o.results + "/" + o.csv;
@@ -138,9 +153,14 @@ int main(int argc, char** argv) {
   }
   csv.close();
   std::printf(
-      "(mode 1: one step at a time; K: sweeps of up to K steps; ns: thread CPU time per "
-      "particle-step)\nwrote %s\n",
+      "(mode 1: one step at a time; K: sweeps of up to K steps; 0: the program's timed choice; "
+      "ns: thread CPU time per particle-step)\nwrote %s\n",
       path.c_str());
+  for (std::size_t m = 0; m < nm; ++m)
+    if (own_beds && o.modes[m] == 0 && sims[m]->sweep_choice())
+      std::printf("mode 0: %lld trials, %lld chose sweeps\n",
+                  static_cast<long long>(sims[m]->sweep_choice()->decisions()),
+                  static_cast<long long>(sims[m]->sweep_choice()->trials_for_sweeps()));
   if (o.plot) {
     const std::string png = path.substr(0, path.rfind('.')) + ".png";
     const std::string cmd = "/usr/bin/python3 " DEM2D_SOURCE_DIR "/post/plot_sweep_modes.py '" +

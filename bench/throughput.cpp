@@ -80,9 +80,9 @@
 // steps (at least 3e6 / N), block 0.5 s + 2 x 0.25 s, the waterfall for 1 s. --csv NAME: write
 // DIR/NAME instead of DIR/throughput.csv (the plot goes beside it with .png). --pair-steps-from N:
 // the drum, deposited and ratio scenes take several steps per sweep from N owned particles on
-// (Simulation::set_pair_steps_from; the program's own threshold otherwise; 0 sweeps at every
+// (Simulation::set_pair_steps_from; the program's own timed choice otherwise; 0 sweeps at every
 // size, a huge N never): the A/B of that change. --sweep-steps K: at most K steps per sweep (2 to
-// 4; Simulation::set_sweep_steps; the program's own otherwise). --profile-*: set up
+// 8; Simulation::set_sweep_steps; the program's own otherwise). --profile-*: set up
 // the scene (the drum's from the cache, which must exist), run the untimed warm-up, then only STEPS
 // steps in profiled_steps() and print one line with the particle-steps, contact-steps and
 // candidate-steps and the CPU time of those steps alone (ns per particle-step); no table, no files.

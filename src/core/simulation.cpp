@@ -1,5 +1,7 @@
 #include "core/simulation.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/fill.hpp"
@@ -14,6 +17,13 @@
 namespace dem2d {
 
 namespace {
+
+// The calling thread's CPU time (s): what the timed choice of sweeps compares.
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 // The scene as the core runs it: the models a table asks for switched on.
 Scene prepared(const Scene& scene) {
@@ -271,15 +281,13 @@ bool Simulation::may_run_ahead(std::int64_t k, bool end_observed) const {
 int Simulation::advance(const std::function<bool(int)>& observed) {
   // Every step of a sweep but its last must run ahead; the last may.
   const std::int64_t base = step_;
+  const int most = most_steps_now();
   int steps = 1;
-  if (baseline_taken_ && particles_.n_owned() >= pair_steps_from_ &&
-      particles_.size() == particles_.n_owned() && domain_->size() == 1 && !grinding_ &&
-      !spectra_ && contacts_.pairs_steps()) {
-    while (steps < sweep_steps_ && may_run_ahead(base + steps, observed(steps))) ++steps;
-    while (steps > 1 && !integrator_->can_sweep(*this, steps)) --steps;
-  }
+  while (steps < most && may_run_ahead(base + steps, observed(steps))) ++steps;
+  while (steps > 1 && !integrator_->can_sweep(*this, steps)) --steps;
   if (steps == 1) {
     step(observed(1));
+    if (choice_started_ && most > 0) choice_.stepped(1);
     return 1;
   }
   population_planned_ = false;
@@ -313,7 +321,37 @@ int Simulation::advance(const std::function<bool(int)>& observed) {
     last_step_again();
   }
   after_step(out[static_cast<std::size_t>(steps - 1)], integrator_->ran_ahead());
+  if (choice_started_) choice_.stepped(steps);
   return steps;
+}
+
+// The most steps advance() may sweep now (1: single steps), by the fixed rule or the timed
+// choice; 0 where sweeps are not allowed at all (the timed choice is then not told of the step).
+int Simulation::most_steps_now() {
+  const std::size_t owned = particles_.n_owned();
+  if (!baseline_taken_ || particles_.size() != owned || domain_->size() != 1 || grinding_ ||
+      spectra_ || !contacts_.pairs_steps())
+    return 0;
+  if (!choose_sweeps_) return owned >= pair_steps_from_ ? sweep_steps_ : 1;
+  if (owned < choose_from_) return 0;
+  if (!choice_started_) {
+    // Blocks of about 2e6 particle-steps (70 ms at 35 ns per particle-step), whole sweeps.
+    const int block =
+        choice_block_steps_ > 0
+            ? choice_block_steps_
+            : std::max(2 * sweep_steps_, static_cast<int>((2000000 / owned + 7) / 8 * 8));
+    choice_ = SweepChoice(block, choice_clock_ ? choice_clock_ : thread_cpu_seconds);
+    choice_started_ = true;
+  }
+  return choice_.next_sweeps() ? std::min(sweep_steps_, choice_.steps_left()) : 1;
+}
+
+void Simulation::set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock) {
+  choose_sweeps_ = true;
+  choose_from_ = n;
+  choice_block_steps_ = block_steps;
+  choice_clock_ = std::move(clock);
+  choice_started_ = false;
 }
 
 void Simulation::set_sweep_steps(int steps) {

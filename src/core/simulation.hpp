@@ -34,6 +34,7 @@
 #include "core/scene.hpp"
 #include "core/spatial_order.hpp"
 #include "core/state_backup.hpp"
+#include "core/sweep_choice.hpp"
 #include "core/time_scales.hpp"
 #include "core/walls.hpp"
 
@@ -98,17 +99,27 @@ class Simulation final : private StepStages {
   // ahead (the closing kick fused with the next kick-drift, the same bits; integrators.hpp).
   // The simulation itself keeps the state whole at the steps it checks or backs up.
   void step(bool end_observed = true);
-  // One step, or several in one sweep over the store when that is allowed and pays (from
-  // pair_steps_from() owned particles, at most sweep_steps(); one rank, Velocity Verlet,
-  // histories written in place, no ore models or collision spectra; integrators.cpp, "Steps in
-  // one sweep"): the same bits as step() called that many times. `observed(k)` says whether
-  // anything reads the particles at the end of the k-th step from now (k = 1: the next step; as
-  // step()'s `end_observed`); a sweep ends at the first such step. Returns the steps taken.
+  // One step, or several in one sweep over the store when that is allowed and pays (at most
+  // sweep_steps(); one rank, Velocity Verlet, histories written in place, no ore models or
+  // collision spectra; integrators.cpp, "Steps in one sweep"): the same bits as step() called
+  // that many times. Whether sweeps pay is measured on the run from kChooseSweepsFrom owned
+  // particles (core/sweep_choice.hpp: blocks of each mode timed in turn by the thread's CPU
+  // clock); below it steps are single. `observed(k)` says whether anything reads the particles
+  // at the end of the k-th step from now (k = 1: the next step; as step()'s `end_observed`); a
+  // sweep ends at the first such step. Returns the steps taken.
   int advance(const std::function<bool(int)>& observed);
-  // The smallest owned count at which advance() sweeps steps (default kPairStepsFrom; tests
-  // lower it, 0 sweeps whenever allowed; a huge value never does).
-  void set_pair_steps_from(std::size_t n) { pair_steps_from_ = n; }
-  std::size_t pair_steps_from() const { return pair_steps_from_; }
+  // A fixed rule instead of the timed choice: sweeps whenever allowed from n owned particles (0:
+  // always; a huge value: never). Tests and benches use it to compare the modes.
+  void set_pair_steps_from(std::size_t n) {
+    pair_steps_from_ = n;
+    choose_sweeps_ = false;
+    choice_started_ = false;
+  }
+  // The timed choice from n owned particles on, its blocks of `block_steps` steps timed by
+  // `clock` (seconds; tests give their own).
+  void set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock);
+  // The timed choice, once it has started (null before and with a fixed rule).
+  const SweepChoice* sweep_choice() const { return choice_started_ ? &choice_ : nullptr; }
   // The most steps advance() takes in one sweep (2 to kMaxSweepSteps; default kSweepSteps).
   void set_sweep_steps(int steps);
   int sweep_steps() const { return sweep_steps_; }
@@ -251,14 +262,22 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  // From this many owned particles advance() sweeps steps, at most eight per sweep, measured in
-  // interleaved blocks of one process (bench/sweep_modes; docs/performance.md, thirteenth
-  // session): on the deposited 1e5 bed eight steps take 0.93 of four steps' time. Below 1e5
-  // sweeps win only while the host's caches are contended (the dense 3e4 bed: 0.83-1.05 of
-  // single steps' time, 1e4: 1.06) and lose on a sparse 40 000-ball waterfall (1.08-1.21).
-  static constexpr std::size_t kPairStepsFrom = 100000;
+  // At most eight steps per sweep, measured in interleaved blocks of one process
+  // (bench/sweep_modes; docs/performance.md, thirteenth session): on the deposited 1e5 bed eight
+  // steps take 0.93 of four steps' time. Whether to sweep at all is timed on the run from
+  // kChooseSweepsFrom owned particles (fourteenth session): below 1e5 sweeps win only while the
+  // host's caches are contended (the dense 3e4 bed: 0.83-1.10 of single steps' time, 1e4: 1.06)
+  // and lose on a sparse 40 000-ball waterfall (1.08-1.21); at 1e5 and above they win.
+  static constexpr std::size_t kChooseSweepsFrom = 20000;
+  int most_steps_now();
   static constexpr int kSweepSteps = 8;
-  std::size_t pair_steps_from_ = kPairStepsFrom;
+  bool choose_sweeps_ = true;
+  std::size_t choose_from_ = kChooseSweepsFrom;
+  int choice_block_steps_ = 0;  // 0: from the owned count (advance)
+  SweepChoice::Clock choice_clock_;
+  SweepChoice choice_;
+  bool choice_started_ = false;
+  std::size_t pair_steps_from_ = 0;  // with a fixed rule
   int sweep_steps_ = kSweepSteps;
   std::int64_t steps_paired_ = 0;
   std::array<std::int64_t, kMaxSweepSteps + 1> sweeps_of_{};

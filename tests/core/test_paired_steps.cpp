@@ -80,6 +80,49 @@ TEST(PairedSteps, HertzMindlinWithRollingEndsBitForBitAsStepByStep) {
     expect_sweeps_change_nothing(s, {0.05, 0.1234, 0.2}, sweep);
 }
 
+// The program's timed choice between single steps and sweeps (core/sweep_choice.hpp) on the same
+// drum, with a clock that makes each trial choose the other mode than the one before: the run
+// switches between the modes at block ends, inside a sweep's reach, and must still end bit for
+// bit as the run stepped one step at a time.
+TEST(PairedSteps, TheTimedChoiceOfModesEndsBitForBitAsStepByStep) {
+  Scene s = thesis_drum_scene(400, 1.8, 16, 0.1);
+  s.contact.model = ContactModelKind::kHertzMindlin;
+  s.contact.rolling = RollingModelKind::kEpsd;
+  s.fills.front().radius_min = 0.05;
+  s.fills.front().radius_max = 0.08;
+  Simulation single(s), timed(s);
+  single.set_pair_steps_from(kNever);
+  double now = 0.0;
+  int calls = 0;
+  timed.set_sweep_choice(0, 12, [&] {
+    if (calls++ % 2 == 1) {  // a block's end: the mode the last trial did not choose is faster
+      const SweepChoice& c = *timed.sweep_choice();
+      const bool favour_sweeps = c.decisions() % 2 == 0;
+      now += c.sweeps_now() == favour_sweeps ? 1.0 : 2.0;
+    }
+    return now;
+  });
+  for (const double t : {0.05, 0.1234, 0.2}) {
+    SCOPED_TRACE(testing::Message() << "t = " << t);
+    single.run_until(t);
+    timed.run_until(t);
+    ASSERT_EQ(timed.step_count(), single.step_count());
+    expect_same_particles(single, timed);
+    testing_support::expect_same_ledger(single, timed);
+    EXPECT_TRUE(same_bits(timed.last_totals().drum_torque, single.last_totals().drum_torque));
+    EXPECT_EQ(timed.neighbor_builds(), single.neighbor_builds());
+  }
+  const SweepChoice& c = *timed.sweep_choice();
+  std::cout << "[ timed    ] " << timed.steps_paired() << " of " << timed.step_count()
+            << " steps in sweeps; " << c.decisions() << " trials, " << c.trials_for_sweeps()
+            << " chose sweeps\n";
+  EXPECT_GE(c.decisions(), 4);
+  EXPECT_GE(c.trials_for_sweeps(), 2);
+  EXPECT_GE(c.decisions() - c.trials_for_sweeps(), 2);
+  EXPECT_GT(timed.steps_paired(), timed.step_count() / 4);
+  EXPECT_LT(timed.steps_paired(), timed.step_count() * 3 / 4);
+}
+
 // A square lattice of 4 900 touching balls of 4 mm, pushed at random, in a circular drum that
 // its corners touch, turning up to speed: the pair list has some 25 chunks, so each later
 // step's loop runs behind the one before through the whole store and hands particles over in
