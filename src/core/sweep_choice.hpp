@@ -22,8 +22,8 @@ namespace dem2d {
 class SweepChoice {
  public:
   static constexpr int kTrialPairs = 3;
-  static constexpr int kExploitBlocks = 24;
-  static constexpr int kMostExploitBlocks = 384;
+  static constexpr int kExploitBlocks = 48;
+  static constexpr int kMostExploitBlocks = 768;
 
   using Clock = std::function<double()>;
   SweepChoice() = default;
