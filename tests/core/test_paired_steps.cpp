@@ -70,14 +70,18 @@ void expect_sweeps_change_nothing(const Scene& scene, std::initializer_list<doub
 // Hertz-Mindlin with the EPSD rolling model (two history slots written in place), 400 balls in
 // a 16-sided drum whose speed ramps up (the drive's power and torque at each step's own pose
 // and speed), filled to the top: balls land, tumble and touch the shell.
-TEST(PairedSteps, HertzMindlinWithRollingEndsBitForBitAsStepByStep) {
+Scene rolling_drum_scene() {
   Scene s = thesis_drum_scene(400, 1.8, 16, 0.1);
   s.contact.model = ContactModelKind::kHertzMindlin;
   s.contact.rolling = RollingModelKind::kEpsd;
   s.fills.front().radius_min = 0.05;
   s.fills.front().radius_max = 0.08;
+  return s;
+}
+
+TEST(PairedSteps, HertzMindlinWithRollingEndsBitForBitAsStepByStep) {
   for (const int sweep : {2, 3, 4, kProgramsSweep})
-    expect_sweeps_change_nothing(s, {0.05, 0.1234, 0.2}, sweep);
+    expect_sweeps_change_nothing(rolling_drum_scene(), {0.05, 0.1234, 0.2}, sweep);
 }
 
 // The program's timed choice between single steps and sweeps (core/sweep_choice.hpp) on the same
@@ -85,11 +89,7 @@ TEST(PairedSteps, HertzMindlinWithRollingEndsBitForBitAsStepByStep) {
 // switches between the modes at block ends, inside a sweep's reach, and must still end bit for
 // bit as the run stepped one step at a time.
 TEST(PairedSteps, TheTimedChoiceOfModesEndsBitForBitAsStepByStep) {
-  Scene s = thesis_drum_scene(400, 1.8, 16, 0.1);
-  s.contact.model = ContactModelKind::kHertzMindlin;
-  s.contact.rolling = RollingModelKind::kEpsd;
-  s.fills.front().radius_min = 0.05;
-  s.fills.front().radius_max = 0.08;
+  const Scene s = rolling_drum_scene();
   Simulation single(s), timed(s);
   single.set_pair_steps_from(kNever);
   double now = 0.0;
