@@ -204,6 +204,8 @@ class Simulation final : private StepStages {
   // Whether step k may leave the store one drift ahead: its end is not observed, nor the run's
   // last, nor checked or backed up.
   bool may_run_ahead(std::int64_t k, bool end_observed) const;
+  // The most steps advance() may take in one sweep now (0: no sweep allowed, 1: single steps).
+  int most_steps_now();
   // After a step: its count, the guard verdict, the energy check and the backup (step()).
   void after_step(const StepOutcome& outcome, bool ran_ahead);
 
@@ -269,7 +271,6 @@ class Simulation final : private StepStages {
   // host's caches are contended (the dense 3e4 bed: 0.83-1.10 of single steps' time, 1e4: 1.06)
   // and lose on a sparse 40 000-ball waterfall (1.08-1.21); at 1e5 and above they win.
   static constexpr std::size_t kChooseSweepsFrom = 20000;
-  int most_steps_now();
   static constexpr int kSweepSteps = 8;
   bool choose_sweeps_ = true;
   std::size_t choose_from_ = kChooseSweepsFrom;
