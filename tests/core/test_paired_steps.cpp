@@ -28,6 +28,26 @@ bool never(int) { return false; }
 // The program's own number of steps per sweep (Simulation::sweep_steps unset).
 constexpr int kProgramsSweep = 0;
 
+// Both runs to each time in `times`, compared there: every field of every particle, the ledger,
+// the totals and the rebuilds, bit for bit.
+void run_both_to(Simulation& single, Simulation& other, std::initializer_list<double> times) {
+  for (const double t : times) {
+    SCOPED_TRACE(testing::Message() << "t = " << t);
+    single.run_until(t);
+    other.run_until(t);
+    ASSERT_EQ(other.step_count(), single.step_count());
+    expect_same_particles(single, other);
+    testing_support::expect_same_ledger(single, other);
+    const EvaluationTotals& x = other.last_totals();
+    const EvaluationTotals& y = single.last_totals();
+    EXPECT_EQ(x.contacts, y.contacts);
+    EXPECT_TRUE(same_bits(x.drum_torque, y.drum_torque));
+    EXPECT_TRUE(same_bits(x.drive_power, y.drive_power));
+    EXPECT_TRUE(same_bits(x.max_overlap, y.max_overlap));
+    EXPECT_EQ(other.neighbor_builds(), single.neighbor_builds());
+  }
+}
+
 // Both runs to each time in `times`, one in sweeps of up to `sweep` steps (kProgramsSweep: the
 // program's default) whenever allowed, one a step at a time.
 void expect_sweeps_change_nothing(const Scene& scene, std::initializer_list<double> times,
@@ -40,21 +60,7 @@ void expect_sweeps_change_nothing(const Scene& scene, std::initializer_list<doub
   else
     paired.set_sweep_steps(sweep);
   SCOPED_TRACE(testing::Message() << "up to " << sweep << " steps per sweep");
-  for (const double t : times) {
-    SCOPED_TRACE(testing::Message() << "t = " << t);
-    single.run_until(t);
-    paired.run_until(t);
-    ASSERT_EQ(paired.step_count(), single.step_count());
-    expect_same_particles(single, paired);
-    testing_support::expect_same_ledger(single, paired);
-    const EvaluationTotals& x = paired.last_totals();
-    const EvaluationTotals& y = single.last_totals();
-    EXPECT_EQ(x.contacts, y.contacts);
-    EXPECT_TRUE(same_bits(x.drum_torque, y.drum_torque));
-    EXPECT_TRUE(same_bits(x.drive_power, y.drive_power));
-    EXPECT_TRUE(same_bits(x.max_overlap, y.max_overlap));
-    EXPECT_EQ(paired.neighbor_builds(), single.neighbor_builds());
-  }
+  run_both_to(single, paired, times);
   std::cout << "[ swept    ] " << paired.steps_paired() << " of " << paired.step_count()
             << " steps in sweeps of up to " << sweep << " (" << paired.sweeps_of(sweep) << " of "
             << sweep << "), " << single.neighbor_builds() << " rebuilds, "
@@ -102,16 +108,7 @@ TEST(PairedSteps, TheTimedChoiceOfModesEndsBitForBitAsStepByStep) {
     }
     return now;
   });
-  for (const double t : {0.05, 0.1234, 0.2}) {
-    SCOPED_TRACE(testing::Message() << "t = " << t);
-    single.run_until(t);
-    timed.run_until(t);
-    ASSERT_EQ(timed.step_count(), single.step_count());
-    expect_same_particles(single, timed);
-    testing_support::expect_same_ledger(single, timed);
-    EXPECT_TRUE(same_bits(timed.last_totals().drum_torque, single.last_totals().drum_torque));
-    EXPECT_EQ(timed.neighbor_builds(), single.neighbor_builds());
-  }
+  run_both_to(single, timed, {0.05, 0.1234, 0.2});
   const SweepChoice& c = *timed.sweep_choice();
   std::cout << "[ timed    ] " << timed.steps_paired() << " of " << timed.step_count()
             << " steps in sweeps; " << c.decisions() << " trials, " << c.trials_for_sweeps()
