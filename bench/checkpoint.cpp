@@ -54,6 +54,7 @@
 #include <vector>
 
 #include "core/simulation.hpp"
+#include "core/sweep_choice.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "parallel/mpi_domain.hpp"
@@ -165,20 +166,13 @@ void as_file_fill(Scene& s, const std::string& label) {
   s.file_fills = {f};
 }
 
-// CPU time of the calling thread (s).
-double thread_cpu() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
 // Wall time of `f` from a barrier and the CPU time of this thread in it, the slowest rank's.
 template <class F>
 std::pair<double, double> timed(MPI_Comm comm, F&& f) {
   MPI_Barrier(comm);
-  const double t0 = MPI_Wtime(), c0 = thread_cpu();
+  const double t0 = MPI_Wtime(), c0 = dem2d::thread_cpu_seconds();
   f();
-  const double wall = MPI_Wtime() - t0, cpu = thread_cpu() - c0;
+  const double wall = MPI_Wtime() - t0, cpu = dem2d::thread_cpu_seconds() - c0;
   return {mpi::max(comm, wall), mpi::max(comm, cpu)};
 }
 

@@ -116,12 +116,7 @@ int main(int argc, char** argv) {
     b.n = n;
     const double steps = std::ceil(o.budget / static_cast<double>(n) / 8.0) * 8.0;
     b.block_steps = static_cast<int>(std::max(8.0, steps));
-    const bench::Packing pk = bench::deposited_packing(n, o.results + "/cache");
-    dem2d::Scene scene = bench::settled_scene(pk, 1.0e-6);
-    scene.drum.speed = 0.0;  // the drum still, as deposited
-    scene.run.spatial_sort = o.sort;
-    b.sim = std::make_unique<dem2d::Simulation>(scene);
-    for (int k = 0; k < 50; ++k) b.sim->step(/*end_observed=*/k + 1 == 50);
+    b.sim = bench::still_bed(n, o.results, o.sort);
     beds.push_back(std::move(b));
   }
 
@@ -174,14 +169,7 @@ int main(int argc, char** argv) {
       "size's fastest block and lower quartile\n over the first size's; contacts: per particle "
       "at the end; N1 = %lld; every size within %.2gx of N1 in every round: %s)\nwrote %s\n",
       static_cast<long long>(beds[0].n), o.bound, above_any == 0 ? "yes" : "no", path.c_str());
-  if (o.plot) {
-    const std::string png = path.substr(0, path.rfind('.')) + ".png";
-    const std::string cmd = "/usr/bin/python3 " DEM2D_SOURCE_DIR "/post/plot_size_blocks.py '" +
-                            path + "' --bound " + std::to_string(o.bound) + " -o '" + png + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::printf("size_blocks: the plot script failed\n");
-    else
-      std::printf("wrote %s\n", png.c_str());
-  }
+  if (o.plot)
+    bench::plot_beside("plot_size_blocks.py", path, " --bound " + std::to_string(o.bound));
   return 0;
 }

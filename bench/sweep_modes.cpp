@@ -92,17 +92,13 @@ int main(int argc, char** argv) {
   if (o.block_steps == 0)
     o.block_steps = std::max<int>(8, static_cast<int>((1600000 / o.n + 7) / 8 * 8));
 
-  const bench::Packing pk = bench::deposited_packing(o.n, o.results + "/cache");
-  dem2d::Scene scene = bench::settled_scene(pk, 1.0e-6);
-  scene.drum.speed = 0.0;  // the drum still, as deposited
   // Mode 0, the program's timed choice, keeps its state from block to block: with it every mode
   // steps its own copy of the bed (all copies hold the same bits after each round).
   const bool own_beds = std::find(o.modes.begin(), o.modes.end(), 0) != o.modes.end();
   const std::size_t nm = o.modes.size();
   std::vector<std::unique_ptr<dem2d::Simulation>> sims;
   for (std::size_t m = 0; m < (own_beds ? nm : 1); ++m) {
-    sims.push_back(std::make_unique<dem2d::Simulation>(scene));
-    for (int k = 0; k < 50; ++k) sims.back()->step(/*end_observed=*/k + 1 == 50);
+    sims.push_back(bench::still_bed(o.n, o.results));
   }
   const auto set_mode = [&](dem2d::Simulation& sim, int mode) {
     if (mode == 1) {
@@ -161,14 +157,6 @@ int main(int argc, char** argv) {
       std::printf("mode 0: %lld trials, %lld chose sweeps\n",
                   static_cast<long long>(sims[m]->sweep_choice()->decisions()),
                   static_cast<long long>(sims[m]->sweep_choice()->trials_for_sweeps()));
-  if (o.plot) {
-    const std::string png = path.substr(0, path.rfind('.')) + ".png";
-    const std::string cmd = "/usr/bin/python3 " DEM2D_SOURCE_DIR "/post/plot_sweep_modes.py '" +
-                            path + "' -o '" + png + "'";
-    if (std::system(cmd.c_str()) != 0)
-      std::printf("sweep_modes: the plot script failed\n");
-    else
-      std::printf("wrote %s\n", png.c_str());
-  }
+  if (o.plot) bench::plot_beside("plot_sweep_modes.py", path);
   return 0;
 }

@@ -1,7 +1,5 @@
 #include "core/simulation.hpp"
 
-#include <time.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,13 +15,6 @@
 namespace dem2d {
 
 namespace {
-
-// The calling thread's CPU time (s): what the timed choice of sweeps compares.
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
 
 // The scene as the core runs it: the models a table asks for switched on.
 Scene prepared(const Scene& scene) {
@@ -287,7 +278,7 @@ int Simulation::advance(const std::function<bool(int)>& observed) {
   while (steps > 1 && !integrator_->can_sweep(*this, steps)) --steps;
   if (steps == 1) {
     step(observed(1));
-    if (choice_started_ && most > 0) choice_.stepped(1);
+    if (choice_ && most > 0) choice_->stepped(1);
     return 1;
   }
   population_planned_ = false;
@@ -321,7 +312,7 @@ int Simulation::advance(const std::function<bool(int)>& observed) {
     last_step_again();
   }
   after_step(out[static_cast<std::size_t>(steps - 1)], integrator_->ran_ahead());
-  if (choice_started_) choice_.stepped(steps);
+  if (choice_) choice_->stepped(steps);
   return steps;
 }
 
@@ -334,16 +325,15 @@ int Simulation::most_steps_now() {
     return 0;
   if (!choose_sweeps_) return owned >= pair_steps_from_ ? sweep_steps_ : 1;
   if (owned < choose_from_) return 0;
-  if (!choice_started_) {
+  if (!choice_) {
     // Blocks of about 2e6 particle-steps (70 ms at 35 ns per particle-step), whole sweeps.
     const int block =
         choice_block_steps_ > 0
             ? choice_block_steps_
             : std::max(2 * sweep_steps_, static_cast<int>((2000000 / owned + 7) / 8 * 8));
-    choice_ = SweepChoice(block, choice_clock_ ? choice_clock_ : thread_cpu_seconds);
-    choice_started_ = true;
+    choice_.emplace(block, choice_clock_ ? choice_clock_ : thread_cpu_seconds);
   }
-  return choice_.next_sweeps() ? std::min(sweep_steps_, choice_.steps_left()) : 1;
+  return choice_->next_sweeps() ? std::min(sweep_steps_, choice_->steps_left()) : 1;
 }
 
 void Simulation::set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock) {
@@ -351,7 +341,7 @@ void Simulation::set_sweep_choice(std::size_t n, int block_steps, SweepChoice::C
   choose_from_ = n;
   choice_block_steps_ = block_steps;
   choice_clock_ = std::move(clock);
-  choice_started_ = false;
+  choice_.reset();
 }
 
 void Simulation::set_sweep_steps(int steps) {

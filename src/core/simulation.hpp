@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -113,13 +114,13 @@ class Simulation final : private StepStages {
   void set_pair_steps_from(std::size_t n) {
     pair_steps_from_ = n;
     choose_sweeps_ = false;
-    choice_started_ = false;
+    choice_.reset();
   }
   // The timed choice from n owned particles on, its blocks of `block_steps` steps timed by
   // `clock` (seconds; tests give their own).
   void set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock);
   // The timed choice, once it has started (null before and with a fixed rule).
-  const SweepChoice* sweep_choice() const { return choice_started_ ? &choice_ : nullptr; }
+  const SweepChoice* sweep_choice() const { return choice_ ? &*choice_ : nullptr; }
   // The most steps advance() takes in one sweep (2 to kMaxSweepSteps; default kSweepSteps).
   void set_sweep_steps(int steps);
   int sweep_steps() const { return sweep_steps_; }
@@ -276,9 +277,8 @@ class Simulation final : private StepStages {
   std::size_t choose_from_ = kChooseSweepsFrom;
   int choice_block_steps_ = 0;  // 0: from the owned count (advance)
   SweepChoice::Clock choice_clock_;
-  SweepChoice choice_;
-  bool choice_started_ = false;
-  std::size_t pair_steps_from_ = 0;  // with a fixed rule
+  std::optional<SweepChoice> choice_;  // started by the first step that may sweep
+  std::size_t pair_steps_from_ = 0;    // with a fixed rule
   int sweep_steps_ = kSweepSteps;
   std::int64_t steps_paired_ = 0;
   std::array<std::int64_t, kMaxSweepSteps + 1> sweeps_of_{};

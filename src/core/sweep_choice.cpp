@@ -1,9 +1,17 @@
 #include "core/sweep_choice.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <utility>
 
 namespace dem2d {
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 namespace {
 // Trial block b: pair b / 2, single steps first in even pairs, sweeps first in odd ones.

@@ -19,6 +19,9 @@
 
 namespace dem2d {
 
+// The calling thread's CPU time (s): the program's clock for the choice (and the benches').
+double thread_cpu_seconds();
+
 class SweepChoice {
  public:
   static constexpr int kTrialPairs = 3;
@@ -26,7 +29,6 @@ class SweepChoice {
   static constexpr int kMostExploitBlocks = 768;
 
   using Clock = std::function<double()>;
-  SweepChoice() = default;
   SweepChoice(int block_steps, Clock clock);
 
   // Whether the next steps are swept (true) or taken one at a time, up to the block's end; at a
