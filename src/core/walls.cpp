@@ -100,6 +100,27 @@ double Walls::max_translation_speed() const {
   return v;
 }
 
+namespace {
+
+// x as a rounded double in a register: no later addition can be fused with the product that made
+// it. GCC 12's vectorizer turned the rotation below, (c a_x - s a_y, s a_x + c a_y), into one
+// fused multiply-add-subtract despite -ffp-contract=off, so a native build (FMA) and a portable
+// one placed the lifters an ulp apart (scripts/check-fma finds any fused instruction in the
+// binary).
+inline double rounded(double x) {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm("" : "+x"(x));
+#endif
+  return x;
+}
+
+// `ref` turned by the rotation (cos, sin) = r.
+Vec2 turned(Vec2 r, Vec2 ref) {
+  return {rounded(r.x * ref.x) - rounded(r.y * ref.y), rounded(r.y * ref.x) + rounded(r.x * ref.y)};
+}
+
+}  // namespace
+
 void Walls::update(double time) {
   for (WallBody& b : bodies_) {
     b.omega = ramp_speed(b.speed, b.ramp_time, time);
@@ -116,8 +137,8 @@ void Walls::update(double time) {
     const WallBody& b = bodies_[e.body];
     const Vec2 origin = b.center + b.offset;
     const Vec2 r = cs[e.body];
-    e.a = origin + Vec2{r.x * e.a_ref.x - r.y * e.a_ref.y, r.y * e.a_ref.x + r.x * e.a_ref.y};
-    e.b = origin + Vec2{r.x * e.b_ref.x - r.y * e.b_ref.y, r.y * e.b_ref.x + r.x * e.b_ref.y};
+    e.a = origin + turned(r, e.a_ref);
+    e.b = origin + turned(r, e.b_ref);
   }
 }
 
