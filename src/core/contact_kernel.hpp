@@ -154,13 +154,13 @@ class Kernel final : public ContactKernel {
 
   // What a pair loop adds up as it goes (pair_contacts, evaluate_sweep).
   struct PairTotals {
-    Pack dissipated{0.0}, elastic{0.0};
+    EightLanes dissipated, elastic;
     double max_ratio = 0.0;
     std::int64_t contacts = 0, worst_a = -1, worst_b = -1;
     void into(EvaluationTotals& tot) const {
       tot.contacts += contacts;
-      tot.dissipated = stdx::reduce(dissipated);
-      tot.elastic = stdx::reduce(elastic);
+      tot.dissipated = dissipated.sum();
+      tot.elastic = elastic.sum();
       tot.max_overlap = max_ratio;
       tot.worst_a = worst_a;
       tot.worst_b = worst_b;
@@ -184,7 +184,8 @@ class Kernel final : public ContactKernel {
                     const double* h);
   void release_wall(const ParticleStore& p, const Walls& walls, std::int32_t i,
                     std::int32_t element, double dt, const double* h);
-  void evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic, Pack& overlap);
+  void evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated, EightLanes& elastic,
+                      Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
   void note_tests_due(std::size_t n);
   void write_records(PairList& pl, std::size_t n);
@@ -465,8 +466,8 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
 
 // B. The contact model on packs of kPackSize contacts.
 template <class Model>
-void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, Pack& elastic,
-                                   Pack& overlap) {
+void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated,
+                                   EightLanes& elastic, Pack& overlap) {
   for (std::size_t c = 0; c < padded(n); c += kPackSize) {
     const Pack dist = vsqrt(load(b_.dist2, c));
     const Pack inv = 1.0 / dist;
@@ -507,8 +508,8 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, Pack& dissipated, P
     const PackMask real =
         Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
         load(b_.counted, c) > 0.5;
-    dissipated += select(real, diss, Pack(0.0));
-    elastic += select(real, el, Pack(0.0));
+    dissipated.add(c, select(real, diss, Pack(0.0)));
+    elastic.add(c, select(real, el, Pack(0.0)));
     overlap = vmax(overlap, ratio);
     store(fx, b_.fx, c);
     store(fy, b_.fy, c);

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 #include "core/intrinsics.hpp"
 // The same warning as in core/intrinsics.hpp, from the simd header's lines.
@@ -21,6 +23,34 @@ namespace stdx = std::experimental;
 using Pack = stdx::native_simd<double>;
 using PackMask = Pack::mask_type;
 inline constexpr int kPackSize = static_cast<int>(Pack::size());
+
+// A sum over the contacts of a pair loop in eight lanes, whatever the build's vector width:
+// contact c of a batch into lane c mod 8, the lanes then added in one fixed order (the order in
+// which stdx::reduce adds a pack of 8). So a rank's energies are the same bits in a build with
+// 8-wide vectors (AVX-512) and in one with 4 (AVX2) or 2 (SSE2), as its particles are.
+class EightLanes {
+ public:
+  static constexpr std::size_t kGroups = 8 / kPackSize;
+  static_assert(kGroups * kPackSize == 8, "a pack of 1, 2, 4 or 8 doubles");
+  // The pack of contacts [c, c + kPackSize) (c a multiple of kPackSize).
+  [[gnu::always_inline]] void add(std::size_t c, const Pack& v) {
+    lanes_[(c / kPackSize) % kGroups] += v;
+  }
+  double sum() const {
+    double l[8];
+    for (std::size_t g = 0; g < kGroups; ++g)
+      lanes_[g].copy_to(l + g * kPackSize, stdx::element_aligned);
+    return ((l[0] + l[4]) + (l[2] + l[6])) + ((l[1] + l[5]) + (l[3] + l[7]));
+  }
+
+ private:
+  std::array<Pack, kGroups> lanes_ = make_zero();
+  static std::array<Pack, kGroups> make_zero() {
+    std::array<Pack, kGroups> z;
+    z.fill(Pack(0.0));
+    return z;
+  }
+};
 
 // Select: c ? a : b, lane by lane.
 [[gnu::always_inline]] inline double select(bool c, double a, double b) { return c ? a : b; }
