@@ -39,9 +39,22 @@ constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 constexpr Vec2 perp(Vec2 a) { return {-a.y, a.x}; }
 constexpr double norm2(Vec2 a) { return dot(a, a); }
 inline double norm(Vec2 a) { return std::sqrt(norm2(a)); }
+// x as a rounded double in a register: no later addition can be fused with the product that made
+// it. GCC 12's vectorizer fused the rotation below into one multiply-add-subtract despite
+// -ffp-contract=off (in Walls::update), so a native build (FMA) and a portable one placed the
+// lifters an ulp apart; scripts/check-fma finds any fused instruction in the program.
+inline double rounded(double x) {
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+  asm("" : "+x"(x));
+#endif
+  return x;
+}
+// `a` turned by the rotation whose (cos, sin) is `cs`: each product rounded on its own.
+inline Vec2 rotate(Vec2 a, Vec2 cs) {
+  return {rounded(cs.x * a.x) - rounded(cs.y * a.y), rounded(cs.y * a.x) + rounded(cs.x * a.y)};
+}
 inline Vec2 rotate(Vec2 a, double angle) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  return {c * a.x - s * a.y, s * a.x + c * a.y};
+  return rotate(a, Vec2{std::cos(angle), std::sin(angle)});
 }
 
 }  // namespace dem2d

@@ -100,27 +100,6 @@ double Walls::max_translation_speed() const {
   return v;
 }
 
-namespace {
-
-// x as a rounded double in a register: no later addition can be fused with the product that made
-// it. GCC 12's vectorizer turned the rotation below, (c a_x - s a_y, s a_x + c a_y), into one
-// fused multiply-add-subtract despite -ffp-contract=off, so a native build (FMA) and a portable
-// one placed the lifters an ulp apart (scripts/check-fma finds any fused instruction in the
-// binary).
-inline double rounded(double x) {
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-  asm("" : "+x"(x));
-#endif
-  return x;
-}
-
-// `ref` turned by the rotation (cos, sin) = r.
-Vec2 turned(Vec2 r, Vec2 ref) {
-  return {rounded(r.x * ref.x) - rounded(r.y * ref.y), rounded(r.y * ref.x) + rounded(r.x * ref.y)};
-}
-
-}  // namespace
-
 void Walls::update(double time) {
   for (WallBody& b : bodies_) {
     b.omega = ramp_speed(b.speed, b.ramp_time, time);
@@ -137,8 +116,8 @@ void Walls::update(double time) {
     const WallBody& b = bodies_[e.body];
     const Vec2 origin = b.center + b.offset;
     const Vec2 r = cs[e.body];
-    e.a = origin + turned(r, e.a_ref);
-    e.b = origin + turned(r, e.b_ref);
+    e.a = origin + rotate(e.a_ref, r);  // core/vec2.hpp: products never fused
+    e.b = origin + rotate(e.b_ref, r);
   }
 }
 
