@@ -1,22 +1,27 @@
-// What the benches that time interleaved blocks in one process share (sweep_modes, size_blocks):
-// the still deposited bed they step, the thread's CPU clock (the program's own, core/
-// sweep_choice.hpp), the quantiles of the per-round ratios and the plot of the CSV.
+// What the benches that time interleaved blocks in one process share (size_blocks, checkpoint):
+// the still deposited bed they step, the thread's CPU clock, the quantiles of the per-round
+// ratios and the plot of the CSV.
 #pragma once
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "core/simulation.hpp"
-#include "core/sweep_choice.hpp"
 #include "settled_drum.hpp"
 
 namespace bench {
 
-using dem2d::thread_cpu_seconds;
+// This thread's CPU time in seconds: a block's cost without the time other processes took.
+inline double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
 
 // The deposited bed of n particles (settled_drum.hpp, deposited_packing: from DIR/cache, or
 // deposited and loaded first), as bench/throughput's deposited section runs it (steel with e =

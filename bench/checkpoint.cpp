@@ -54,7 +54,7 @@
 #include <vector>
 
 #include "core/simulation.hpp"
-#include "core/sweep_choice.hpp"
+#include "blocks.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "parallel/mpi_domain.hpp"
@@ -170,9 +170,9 @@ void as_file_fill(Scene& s, const std::string& label) {
 template <class F>
 std::pair<double, double> timed(MPI_Comm comm, F&& f) {
   MPI_Barrier(comm);
-  const double t0 = MPI_Wtime(), c0 = dem2d::thread_cpu_seconds();
+  const double t0 = MPI_Wtime(), c0 = bench::thread_cpu_seconds();
   f();
-  const double wall = MPI_Wtime() - t0, cpu = dem2d::thread_cpu_seconds() - c0;
+  const double wall = MPI_Wtime() - t0, cpu = bench::thread_cpu_seconds() - c0;
   return {mpi::max(comm, wall), mpi::max(comm, cpu)};
 }
 

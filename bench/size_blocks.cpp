@@ -1,11 +1,11 @@
-// size_blocks: the cost per particle-step against the charge's size (issue 13's bound: every size
-// within 1.3x of the 1e4 cost), measured so that the host's speed phases cancel.
+// size_blocks: the cost per particle-step against the charge's size (the bound: every size within
+// 1.3x of the 1e4 cost), measured so that the host's speed phases cancel.
 //
 // One process holds the deposited beds of every size asked for (settled_drum.hpp,
 // deposited_packing, as bench/throughput's deposited section: steel with e = 0.1 and mu_s = 0.5,
 // the drum still, dt = 1e-6 s), each warmed by 50 steps, and steps them in blocks that take the
-// sizes in turn, the order rotated each round. Each size steps as the program would (advance():
-// single steps or sweeps by the program's own threshold). A block is about --budget particle-steps
+// sizes in turn, the order rotated each round. Each size steps as the program would (step(), the
+// closing kick fused with the next drift but at the block's last step). A block is about --budget particle-steps
 // (its steps a multiple of 8, at least 8), timed by the thread's CPU clock and compared with the
 // first size's block of the same round: a slow minute of the host falls on neighbouring blocks of
 // every size alike. bench/size_rounds.py runs each size as its own process instead, where the same
@@ -126,8 +126,7 @@ int main(int argc, char** argv) {
       Bed& b = beds[(q + static_cast<std::size_t>(r)) % nb];
       dem2d::Simulation& sim = *b.sim;
       const double t0 = bench::thread_cpu_seconds();
-      for (int k = 0; k < b.block_steps;)
-        k += sim.advance([&](int j) { return k + j == b.block_steps; });
+      for (int k = 1; k <= b.block_steps; ++k) sim.step(/*end_observed=*/k == b.block_steps);
       b.ns.push_back(1e9 * (bench::thread_cpu_seconds() - t0) /
                      (static_cast<double>(b.n) * b.block_steps));
     }

@@ -70,7 +70,6 @@
 //              [--steps S] [--repeats R]
 //              [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot] [--no-cache]
 //              [--results DIR] [--csv NAME] [--order-particles N1,N2,...]
-//              [--pair-steps-from N] [--sweep-steps K]
 //   throughput --profile-block STEPS      (bench/profile_contacts.sh)
 //   throughput --profile-drum N STEPS
 //
@@ -78,11 +77,7 @@
 // the waterfall only, as the program did before it had sections; --skip-waterfall drops the
 // waterfall from either. --quick: N = 1000, 3000, deposited 3000, 10000, ratios at N = 2000, 300
 // steps (at least 3e6 / N), block 0.5 s + 2 x 0.25 s, the waterfall for 1 s. --csv NAME: write
-// DIR/NAME instead of DIR/throughput.csv (the plot goes beside it with .png). --pair-steps-from N:
-// the drum, deposited and ratio scenes take several steps per sweep from N owned particles on
-// (Simulation::set_pair_steps_from; the program's own timed choice otherwise; 0 sweeps at every
-// size, a huge N never): the A/B of that change. --sweep-steps K: at most K steps per sweep (2 to
-// 8; Simulation::set_sweep_steps; the program's own otherwise). --profile-*: set up
+// DIR/NAME instead of DIR/throughput.csv (the plot goes beside it with .png). --profile-*: set up
 // the scene (the drum's from the cache, which must exist), run the untimed warm-up, then only STEPS
 // steps in profiled_steps() and print one line with the particle-steps, contact-steps and
 // candidate-steps and the CPU time of those steps alone (ns per particle-step); no table, no files.
@@ -173,8 +168,6 @@ struct Options {
   std::int64_t ratio_particles = 20000;
   std::vector<std::int64_t> order_particles = {100000, 1000000};
   std::int64_t steps = 2000;
-  std::int64_t pair_steps_from = -1;  // --pair-steps-from: Simulation::set_pair_steps_from
-  int sweep_steps = 0;                // --sweep-steps: Simulation::set_sweep_steps
   int repeats = 2;
   double min_particle_steps = 3.0e7;
   double max_particle_steps = 3.0e8;
@@ -265,9 +258,6 @@ Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row
   malloc_trim(0);
   const double rss0 = rss_bytes();
   Simulation sim(scene);
-  if (opt.pair_steps_from >= 0)
-    sim.set_pair_steps_from(static_cast<std::size_t>(opt.pair_steps_from));
-  if (opt.sweep_steps > 0) sim.set_sweep_steps(opt.sweep_steps);
   for (int k = 0; k < kWarmupSteps; ++k) sim.step(/*end_observed=*/k + 1 == kWarmupSteps);
   const auto n = static_cast<double>(row.n);
   row.rss_per_particle = (rss_bytes() - rss0) / n;
@@ -276,8 +266,7 @@ Row measure_packing(const Options& opt, const bench::Packing& pk, double dt, Row
   const std::int64_t builds0 = sim.neighbor_builds();
   for (int rep = 0; rep < opt.repeats; ++rep) {
     const Stopwatch sw;
-    for (std::int64_t k = 0; k < row.steps;)
-      k += sim.advance([&](int j) { return k + j == row.steps; });
+    for (std::int64_t k = 1; k <= row.steps; ++k) sim.step(/*end_observed=*/k == row.steps);
     const double cpu = sw.cpu(), wall = sw.wall();
     if (rep == 0 || cpu < row.cpu) {
       row.cpu = cpu;
@@ -497,7 +486,6 @@ int run_profile(const Options& opt) {
       "                  [--ratios R1,R2,...] [--ratio-particles N] [--steps S] [--repeats R]\n"
       "                  [--block-warmup T] [--block-time T] [--skip-waterfall] [--no-plot]\n"
       "                  [--no-cache] [--results DIR] [--csv NAME] [--order-particles N1,...]\n"
-      "                  [--pair-steps-from N] [--sweep-steps K]\n"
       "       throughput --profile-block STEPS | --profile-drum N STEPS [--results DIR]\n");
   std::exit(code);
 }
@@ -535,10 +523,6 @@ Options parse(int argc, char** argv) {
     } else if (a == "--deposited") {
       o.deposited = bench::parse_list<std::int64_t>(value());
       deposited_given = true;
-    } else if (a == "--pair-steps-from") {
-      o.pair_steps_from = std::stoll(value());
-    } else if (a == "--sweep-steps") {
-      o.sweep_steps = std::stoi(value());
     } else if (a == "--deposited-speed") {
       o.deposited_speed = std::stod(value());
     } else if (a == "--order-particles") {

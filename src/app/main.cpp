@@ -374,7 +374,7 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
   }
   try {
     while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
-      sim_.advance([&](int k) { return observes_step(sim_.step_count() + k); });
+      sim_.step(observes_step(sim_.step_count() + 1));
       after_step();
       if (polls_at(sim_.step_count()) && stop_requested()) return finish(Ending::kInterrupted);
       progress.update(sim_, n_global);
@@ -478,7 +478,6 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
       wall > 0 ? static_cast<double>(n_global) * static_cast<double>(steps_here) / wall : 0.0;
   info.dt = sim.dt();
   info.extra.emplace_back("neighbor_builds", std::to_string(sim.neighbor_builds()));
-  info.extra.emplace_back("steps_in_sweeps", std::to_string(sim.steps_paired()));
   if (scene.run.integrator == IntegratorKind::kIterative) {
     info.extra.emplace_back("mean_passes",
                             fmt_double("%.6g", static_cast<double>(sim.passes_total()) /
@@ -611,12 +610,7 @@ int run(const Options& opt) {
   if (!opt.quiet && ending == Ending::kFinished)
     say(fmt_double("done: %.4g s simulated", sim.time()) +
         fmt_double(" in %.3g s of wall time", wall) +
-        fmt_double(" (%.3g particle-steps/s", info.particle_steps_per_second) +
-        (sim.steps_paired() > 0
-             ? "; " + std::to_string(sim.steps_paired()) + " of " +
-                   std::to_string(sim.step_count() - first_step) + " steps in sweeps"
-             : std::string()) +
-        ")\n");
+        fmt_double(" (%.3g particle-steps/s)\n", info.particle_steps_per_second));
   return report(opt, scene, sim, loop, ending);
 }
 

@@ -56,11 +56,6 @@ void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
   kernel_->evaluate(p, walls, pairs_, wall_pairs_, dt, totals_);
 }
 
-void ContactEngine::evaluate_sweep(ParticleStore& p, double dt, StepSweep& sweep,
-                                   std::span<EvaluationTotals> early) {
-  kernel_->evaluate_sweep(p, pairs_, wall_pairs_, dt, sweep, early, totals_);
-}
-
 void ContactEngine::commit() {
   if (!kernel_->histories_in_place()) pairs_.history.swap(pairs_.trial);
   wall_pairs_.history.swap(wall_pairs_.trial);

@@ -43,26 +43,6 @@ struct EvaluationTotals {
   std::int64_t worst_a = -1, worst_b = -1;  // ids at max_overlap (b = -1: a wall)
 };
 
-// Velocity Verlet's steps in one sweep over the pair list (ContactKernel::evaluate_sweep,
-// VelocityVerlet::sweep_steps): the walls at each step's pose, and told, as the sweep goes, that
-// the forces of a further range of the owned particles are complete for one of the steps. Each
-// step's ranges come in order, each starting where the last ended, their bounds multiples of 8
-// but for the last, which ends at n_owned.
-class StepSweep {
- public:
-  // The walls where they are at step `step` of the sweep (0: the first).
-  virtual const Walls& walls(int step) const = 0;
-  // Step `step`'s forces on owned particles [from, to) are complete (pairs and walls): close
-  // that step and drift them to the next step's state (their mirror lines written).
-  virtual void done(int step, std::size_t from, std::size_t to) = 0;
-
- protected:
-  ~StepSweep() = default;
-};
-
-// The most steps one sweep takes (ContactKernel::evaluate_sweep).
-inline constexpr int kMaxSweepSteps = 8;
-
 // The force loop for one contact model, instantiated at setup (contact_engine.cpp).
 class ContactKernel {
  public:
@@ -84,17 +64,6 @@ class ContactKernel {
   // With the breakage tracker: the pair-list entries of the last evaluation whose breakage test
   // is due (TrackBreakage::test_due of their new histories), in list order. Empty otherwise.
   virtual std::span<const std::int32_t> breakage_tests_due() const { return {}; }
-  // Whether evaluate_sweep is available (histories written in place, nothing tracked).
-  virtual bool pairs_steps() const { return false; }
-  // The force evaluations of early.size() + 1 steps (2 to kMaxSweepSteps) in one sweep over the
-  // lists, each at the state the step before's closing kick and drift (told through `sweep`)
-  // leave: the same forces, histories and totals, bit for bit, as that many evaluations with the
-  // steps between them. The pair list in canonical order and no ghosts; the walls at each step's
-  // pose from `sweep`. The totals of all steps but the last into `early`, the last's into
-  // `last`; the wall histories end where they would after the evaluations and their commits.
-  virtual void evaluate_sweep(ParticleStore& /*p*/, PairList& /*pl*/, WallPairList& /*wl*/,
-                              double /*dt*/, StepSweep& /*sweep*/,
-                              std::span<EvaluationTotals> /*early*/, EvaluationTotals& /*last*/) {}
 };
 // The kernel of the scene's law, rolling model (none when no pair has rolling friction), tracker
 // and the stepper that matches the integrator.
@@ -118,10 +87,6 @@ class ContactEngine {
   void evaluate(ParticleStore& p, const Walls& walls, double dt);
   // See ContactKernel::histories_in_place.
   bool histories_in_place() const { return kernel_->histories_in_place(); }
-  // See ContactKernel::pairs_steps and evaluate_sweep (the last step's totals become totals()).
-  bool pairs_steps() const { return kernel_->pairs_steps() && pairs_.canonical(); }
-  void evaluate_sweep(ParticleStore& p, double dt, StepSweep& sweep,
-                      std::span<EvaluationTotals> early);
   // See ContactKernel::drift_mirror.
   PairKinematics* drift_mirror(const ParticleStore& p) { return kernel_->drift_mirror(p); }
   // The pairs' histories as the last evaluation wrote them: the committed ones when written in
@@ -132,8 +97,6 @@ class ContactEngine {
   // See ContactKernel::breakage_tests_due.
   std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }
-  // Put back the totals of an earlier evaluation (a swept step's, for its guards).
-  void restore_totals(const EvaluationTotals& t) { totals_ = t; }
   // The trial histories become the committed ones.
   void commit();
 

@@ -60,8 +60,7 @@ template <class Model>
 inline std::size_t padded(std::size_t n) { return (n + kPackSize - 1) / kPackSize * kPackSize; }
 
 // From this many particles (owned and ghosts) the canonical scatter fetches its partners' lines
-// ahead (Kernel::scatter_pairs); in a sweep of steps it always does (evaluate_sweep: at 3e4, four
-// steps per sweep took 0.95 of the time with it, in-process interleaved blocks).
+// ahead (Kernel::scatter_pairs).
 inline constexpr std::size_t kScatterPrefetchFrom = 50000;
 
 // The force loop for one contact model (style.md item 4: written once, the model chosen at
@@ -107,15 +106,9 @@ class Kernel final : public ContactKernel {
     live_pairs_.swap(next_live_pairs_);
     live_walls_.swap(next_live_walls_);
   }
-  void lists_changed() override {
-    rescan_ = true;
-    sweep_plan_stale_ = true;
-  }
+  void lists_changed() override { rescan_ = true; }
   bool histories_in_place() const override { return kInPlace; }
   std::span<const std::int32_t> breakage_tests_due() const override { return tests_due_; }
-  bool pairs_steps() const override { return kPairs; }
-  void evaluate_sweep(ParticleStore& p, PairList& pl, WallPairList& wl, double dt, StepSweep& sweep,
-                      std::span<EvaluationTotals> early, EvaluationTotals& last) override;
   PairKinematics* drift_mirror(const ParticleStore& p) override {
 #if DEM2D_VECTOR_GATHER
     if (vector_gather_) {
@@ -152,7 +145,7 @@ class Kernel final : public ContactKernel {
     return out;
   }
 
-  // What a pair loop adds up as it goes (pair_contacts, evaluate_sweep).
+  // What a pair loop adds up as it goes (pair_contacts).
   struct PairTotals {
     EightLanes dissipated, elastic;
     double max_ratio = 0.0;
@@ -197,28 +190,12 @@ class Kernel final : public ContactKernel {
   void sum_records(ParticleStore& p, const PairList& pl);
   void wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                      EvaluationTotals& tot);
-  // Wall entries `entries[0, count)` (null: all, in list order), their histories read from `old`
-  // and rewritten into `fresh`.
-  std::size_t gather_walls(const ParticleStore& p, const Walls& walls, const WallPairList& wl,
-                           const std::int32_t* entries, std::size_t count, const double* old,
-                           double* fresh);
+  // The wall entries in list order, their histories read from the committed slots and rewritten
+  // into the trial slots.
+  std::size_t gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl);
   void evaluate_walls(std::size_t n, double dt);
   void scatter_walls(ParticleStore& p, const Walls& walls, WallPairList& wl, std::size_t n,
                      EvaluationTotals& tot);
-  // The sweep's wall contacts (evaluate_sweep): each contact's forces and its shares of
-  // the totals, kept per list entry, added to the particles when their pairs are done and to the
-  // totals in list order at the end: what scatter_walls adds, in its order.
-  struct WallRecord {
-    double fx, fy, torque, ex, ey, diss_law, el_law, diss_roll, el_roll, drive, drum, ratio;
-    bool touch, on_drum, lifter;
-  };
-  void record_walls(const Walls& walls, const WallPairList& wl, std::size_t n, double* fresh,
-                    std::vector<WallRecord>& out);
-  void apply_walls(ParticleStore& p, const WallPairList& wl, const std::vector<WallRecord>& rec,
-                   std::size_t& cursor, std::size_t end) const;
-  void wall_totals(const ParticleStore& p, const WallPairList& wl,
-                   const std::vector<WallRecord>& rec, EvaluationTotals& tot) const;
-  void plan_sweep(const PairList& pl, const WallPairList& wl);
 
   int n_mat_;
   std::vector<Coeffs> coeffs_;  // [a * n_mat_ + b]
@@ -243,8 +220,6 @@ class Kernel final : public ContactKernel {
   // chunks' new histories, where the grinding's scan of every entry's history after the step
   // had cost 7 % of the grinding deck's time.
   static constexpr bool kFlagsTests = std::is_same_v<typename Model::Tracker, TrackBreakage>;
-  // Steps in one sweep (evaluate_sweep): histories in place, no tests to name.
-  static constexpr bool kPairs = kInPlace && !kFlagsTests;
   std::vector<std::int32_t> tests_due_;
   // The list entries in contact in the committed histories (the only ones that can end in this
   // step), and those in contact in this evaluation (committed next). After a rebuild they are
@@ -266,12 +241,7 @@ class Kernel final : public ContactKernel {
   };
   Array<std::uint8_t> touch_;
   Array<ForceRecord> records_;
-  // The sweep's plan, made again after every rebuild: per chunk the largest partner
-  // index, and the wall entries in particle order (stable: list order within a particle).
-  bool sweep_plan_stale_ = true;
   bool prefetch_scatter_ = false;  // scatter_pairs fetches the partners' lines ahead
-  std::vector<std::int32_t> chunk_last_j_, wall_order_;
-  std::array<std::vector<WallRecord>, kMaxSweepSteps> wall_records_;
 };
 
 // The candidates are processed in chunks, each through phases A, B and C, so that the batch
@@ -618,8 +588,7 @@ template <class Model>
 void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPairList& wl, double dt,
                                   EvaluationTotals& tot) {
   wb_.reserve(wl.size() + kPackSize);
-  const std::size_t n =
-      gather_walls(p, walls, wl, nullptr, wl.size(), wl.history.data(), wl.trial.data());
+  const std::size_t n = gather_walls(p, walls, wl);
   evaluate_walls(n, dt);
   scatter_walls(p, walls, wl, n, tot);
   if constexpr (kTrackRelease)
@@ -629,8 +598,9 @@ void Kernel<Model>::wall_contacts(ParticleStore& p, const Walls& walls, WallPair
 
 template <class Model>
 std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& walls,
-                                        const WallPairList& wl, const std::int32_t* entries,
-                                        std::size_t count, const double* old, double* fresh) {
+                                        WallPairList& wl) {
+  const double* old = wl.history.data();
+  double* fresh = wl.trial.data();
   const Vec2* x = p.pos.data();
   const Vec2* v = p.vel.data();
   const double* w = p.omega.data();
@@ -639,8 +609,7 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
   const WallElement* elements = walls.elements().data();
   const WallBody* bodies = walls.bodies().data();
   std::size_t n = 0;
-  for (std::size_t e_k = 0; e_k < count; ++e_k) {
-    const std::size_t k = entries ? static_cast<std::size_t>(entries[e_k]) : e_k;
+  for (std::size_t k = 0; k < wl.size(); ++k) {
     const std::int32_t i = wl.particle[k];
     for (std::size_t s = 0; s < W; ++s) fresh[k * W + s] = 0.0;  // the scatter rewrites contacts
     const WallElement& e = elements[wl.element[k]];
@@ -761,202 +730,6 @@ void Kernel<Model>::scatter_walls(ParticleStore& p, const Walls& walls, WallPair
   tot.dissipated = dissipated;
   tot.elastic = elastic;
   tot.max_overlap = max_ratio;
-}
-
-// The sweep's wall contacts: the gathered contacts' new histories into `fresh` and their
-// records (per list entry), with scatter_walls's expressions.
-template <class Model>
-void Kernel<Model>::record_walls(const Walls& walls, const WallPairList& wl, std::size_t n,
-                                 double* fresh, std::vector<WallRecord>& out) {
-  const WallElement* elements = walls.elements().data();
-  const WallBody* bodies = walls.bodies().data();
-  const int drum = walls.drum_body();
-  const Vec2 drum_center = walls.has_drum() ? bodies[drum].center : Vec2{};
-  for (std::size_t c = 0; c < n; ++c) {
-    const std::int32_t k = wb_.pair[c];
-    const WallElement& e = elements[wl.element[k]];
-    const Vec2 fi{wb_.fx[c], wb_.fy[c]};
-    const double m_roll = wb_.m_roll[c];
-    for (std::size_t s = 0; s < W; ++s)
-      fresh[static_cast<std::size_t>(k) * W + s] = wb_.history.fresh[s][c];
-    WallRecord& r = out[k];
-    r = WallRecord{fi.x,
-                   fi.y,
-                   wb_.torque[c],
-                   wb_.ex[c],
-                   wb_.ey[c],
-                   wb_.diss_law[c],
-                   wb_.el_law[c],
-                   wb_.diss_roll[c],
-                   wb_.el_roll[c],
-                   dot(fi, Vec2{wb_.wx[c], wb_.wy[c]}) + m_roll * bodies[e.body].omega,
-                   0.0,
-                   wb_.delta[c] / wb_.r[c],
-                   true,
-                   e.body == drum,
-                   e.part == WallPart::kLifter};
-    if (r.on_drum) r.drum = cross(Vec2{wb_.px[c], wb_.py[c]} - drum_center, fi) + m_roll;
-  }
-}
-
-// The recorded wall forces on the particles below `end` (wall_order_ from `cursor`).
-template <class Model>
-void Kernel<Model>::apply_walls(ParticleStore& p, const WallPairList& wl,
-                                const std::vector<WallRecord>& rec, std::size_t& cursor,
-                                std::size_t end) const {
-  Vec2* f = p.force.data();
-  double* tq = p.torque.data();
-  Vec2* f_el = p.elastic_force.data();
-  for (; cursor < wall_order_.size(); ++cursor) {
-    const std::int32_t k = wall_order_[cursor];
-    const auto i = static_cast<std::size_t>(wl.particle[k]);
-    if (i >= end) break;
-    const WallRecord& r = rec[k];
-    if (!r.touch) continue;
-    f[i] += Vec2{r.fx, r.fy};
-    tq[i] += r.torque;
-    f_el[i] += Vec2{r.ex, r.ey};
-  }
-}
-
-// The recorded contacts' shares of the totals in list order, after the pairs': scatter_walls's.
-template <class Model>
-void Kernel<Model>::wall_totals(const ParticleStore& p, const WallPairList& wl,
-                                const std::vector<WallRecord>& rec, EvaluationTotals& tot) const {
-  double dissipated = tot.dissipated, elastic = tot.elastic, max_ratio = tot.max_overlap;
-  for (std::size_t k = 0; k < wl.size(); ++k) {
-    const WallRecord& r = rec[k];
-    if (!r.touch) continue;
-    dissipated += r.diss_law;
-    elastic += r.el_law;
-    if constexpr (Model::Rolling::kActive) {
-      dissipated += r.diss_roll;
-      elastic += r.el_roll;
-    }
-    tot.drive_power += r.drive;
-    if (r.on_drum) {
-      tot.drum_torque += r.drum;
-      if (r.lifter) tot.lifter_torque += r.drum;
-    }
-    if (r.ratio > max_ratio) {
-      max_ratio = r.ratio;
-      tot.worst_a = p.id[wl.particle[k]];
-      tot.worst_b = -1;
-    }
-    tot.contacts += 1;
-  }
-  tot.dissipated = dissipated;
-  tot.elastic = elastic;
-  tot.max_overlap = max_ratio;
-}
-
-template <class Model>
-void Kernel<Model>::plan_sweep(const PairList& pl, const WallPairList& wl) {
-  const std::size_t chunks = (pl.size() + kChunk - 1) / kChunk;
-  chunk_last_j_.assign(chunks, 0);
-  for (std::size_t c = 0; c < chunks; ++c)
-    for (std::size_t k = c * kChunk; k < std::min(pl.size(), (c + 1) * kChunk); ++k)
-      chunk_last_j_[c] = std::max(chunk_last_j_[c], pl.j[k]);
-  wall_order_.resize(wl.size());
-  for (std::size_t k = 0; k < wl.size(); ++k) wall_order_[k] = static_cast<std::int32_t>(k);
-  std::stable_sort(wall_order_.begin(), wall_order_.end(),
-                   [&](std::int32_t a, std::int32_t b) { return wl.particle[a] < wl.particle[b]; });
-  sweep_plan_stale_ = false;
-}
-
-// Steps in one sweep (ContactKernel::evaluate_sweep). The first step's chunks run in list order
-// as in pair_contacts; after each, the owned particles below the next chunk's first particle
-// (rounded down to a multiple of 8) have all their pairs: their first-step wall forces are added
-// (evaluated before the sweep, at the first pose), the sweep closes and drifts them, and their
-// second-step wall contacts are evaluated at once (the walls at the second pose). A chunk of a
-// later step runs as soon as every particle it names has been drifted by the step before, and
-// hands its complete particles on the same way, so each step's loop follows the one before
-// through the store. Each particle's sums are the same additions in the same order as in
-// separate evaluations; the totals are added in the same order too.
-template <class Model>
-void Kernel<Model>::evaluate_sweep(ParticleStore& p, PairList& pl, WallPairList& wl, double dt,
-                                   StepSweep& sweep, std::span<EvaluationTotals> early,
-                                   EvaluationTotals& last) {
-  if constexpr (!kPairs) {
-    throw std::logic_error("evaluate_sweep: this contact model does not sweep steps");
-  } else {
-    const int steps = static_cast<int>(early.size()) + 1;
-    if (steps < 2 || steps > kMaxSweepSteps)
-      throw std::logic_error("evaluate_sweep: 2 to kMaxSweepSteps steps");
-    const auto totals = [&](int s) -> EvaluationTotals& {
-      return s + 1 < steps ? early[static_cast<std::size_t>(s)] : last;
-    };
-    if (sweep_plan_stale_) plan_sweep(pl, wl);
-    prefetch_scatter_ = true;
-    const std::size_t n = p.n_owned();
-    for (int s = 0; s < steps; ++s) {
-      totals(s) = EvaluationTotals{};
-      wall_records_[static_cast<std::size_t>(s)].assign(wl.size(), WallRecord{});
-    }
-    wb_.reserve(wl.size() + kPackSize);
-    // Step s reads the wall histories from slot s % 2 and writes slot (s + 1) % 2 (the committed
-    // and the trial slots): the commit's swap after each step leaves the last one's committed.
-    double* const slot[2] = {wl.history.data(), wl.trial.data()};
-    const auto wall_step = [&](int s, const std::int32_t* entries, std::size_t count) {
-      const Walls& walls = sweep.walls(s);
-      const std::size_t m =
-          gather_walls(p, walls, wl, entries, count, slot[s % 2], slot[(s + 1) % 2]);
-      evaluate_walls(m, dt);
-      record_walls(walls, wl, m, slot[(s + 1) % 2], wall_records_[static_cast<std::size_t>(s)]);
-    };
-    wall_step(0, nullptr, wl.size());  // the first step's, at its pose, before the sweep
-    prepare_pairs(p, pl);
-    std::array<PairTotals, kMaxSweepSteps> sums{};
-    // Per step: owned particles closed and drifted ([0, done)), the next chunk of the list, and
-    // cursors in wall_order_ (wall forces applied, wall contacts evaluated).
-    std::array<std::size_t, kMaxSweepSteps> done{}, next{}, applied{}, evaluated{};
-    const std::size_t chunks = (pl.size() + kChunk - 1) / kChunk;
-    const auto complete_after = [&](std::size_t c) {
-      return c + 1 < chunks ? static_cast<std::size_t>(pl.i[(c + 1) * kChunk]) & ~std::size_t{7}
-                            : n;
-    };
-    // Step s's particles below `to` have all their pairs: not past the step before's hand-over (a
-    // particle without pairs is complete as soon as the step before has drifted it), their wall
-    // forces added, their step closed and drifted; then the next step's wall contacts there.
-    const auto hand_over = [&](int s, std::size_t to) {
-      const auto u = static_cast<std::size_t>(s);
-      if (s > 0) to = std::min(to, done[u - 1]);
-      if (to <= done[u]) return;
-      apply_walls(p, wl, wall_records_[u], applied[u], to);
-      sweep.done(s, done[u], to);
-      done[u] = to;
-      if (s + 1 == steps) return;
-      std::size_t& e = evaluated[u + 1];
-      const std::size_t from = e;
-      while (e < wall_order_.size() && static_cast<std::size_t>(wl.particle[wall_order_[e]]) < to)
-        ++e;
-      if (e > from) wall_step(s + 1, wall_order_.data() + from, e - from);
-    };
-    // Step s's chunks whose last partner the step before has drifted (all: every one left).
-    const auto later_chunks = [&](int s, bool all) {
-      const auto u = static_cast<std::size_t>(s);
-      while (next[u] < chunks &&
-             (all || static_cast<std::size_t>(chunk_last_j_[next[u]]) < done[u - 1])) {
-        pair_chunk(p, pl, next[u] * kChunk, std::min(pl.size(), (next[u] + 1) * kChunk), dt,
-                   sums[u]);
-        hand_over(s, complete_after(next[u]++));
-      }
-    };
-    for (std::size_t c = 0; c < chunks; ++c) {
-      pair_chunk(p, pl, c * kChunk, std::min(pl.size(), (c + 1) * kChunk), dt, sums[0]);
-      hand_over(0, complete_after(c));
-      for (int s = 1; s < steps; ++s) later_chunks(s, false);
-    }
-    hand_over(0, n);
-    for (int s = 1; s < steps; ++s) {
-      later_chunks(s, true);
-      hand_over(s, n);
-    }
-    for (int s = 0; s < steps; ++s) {
-      sums[static_cast<std::size_t>(s)].into(totals(s));
-      wall_totals(p, wl, wall_records_[static_cast<std::size_t>(s)], totals(s));
-    }
-  }
 }
 
 // The stepper follows the integrator (contact_models.hpp, Steppers).

@@ -328,101 +328,57 @@ template <bool kDrift>
 
 #endif
 
-// The closing pass over the owned particles, run over consecutive ranges [from, to) (bounds
-// multiples of 8 but for the last, which ends at n; one range [0, n) is the whole pass): eight
-// particles per iteration over the first whole eights, with the sums' lanes 0-3 and 4-7 in two
-// registers each carried from range to range, then the rest one at a time into lane 0. Any cut
-// into such ranges gives the bits of one pass (VelocityVerlet::sweep_steps hands them over as
-// the pair loop completes them).
-template <bool kDrift>
-class ClosingRanges {
- public:
-  ClosingRanges(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
-                PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time)
-      : c_(closing_columns(p, x_build, mirror)),
-        h_(0.5 * dt),
-        dt_(dt),
-        g_(gravity),
-        n_(p.n_owned()),
-        whole_(n_ / kSumLanes * kSumLanes) {
 #if DEM2D_VECTOR_GATHER
-    fours_ = four_at_a_time;
-#endif
+// The four-lane registers of the whole eights into the sums (before the first particle past
+// them): lanes 0-3 and 4-7 of the two sums, the maxima lane by lane.
+void flush_lanes(const FourMaxima& most, const __m256d (&checksum)[2], const __m256d (&late)[2],
+                 ClosingSums& sums) {
+  for (std::size_t half = 0; half < 2; ++half) {
+    _mm256_storeu_pd(sums.checksum + 4 * half, checksum[half]);
+    _mm256_storeu_pd(sums.late_power + 4 * half, late[half]);
   }
-  void run(std::size_t from, std::size_t to) {
-    std::size_t k = from;
-#if DEM2D_VECTOR_GATHER
-    if (fours_) {
-      const ClosingColumns c = c_;  // local: the stores below may alias the object (eighth session)
-      FourMaxima most = most_;
-      __m256d checksum0 = checksum_[0], checksum1 = checksum_[1];
-      __m256d late0 = late_[0], late1 = late_[1];
-      const std::size_t end = std::min(to, whole_);
-      for (; k < end; k += 8) {
-        close_four<kDrift>(k, h_, dt_, g_, c, most, checksum0, late0);
-        close_four<kDrift>(k + 4, h_, dt_, g_, c, most, checksum1, late1);
-      }
-      most_ = most;
-      checksum_[0] = checksum0;
-      checksum_[1] = checksum1;
-      late_[0] = late0;
-      late_[1] = late1;
-      if (k < to) flush();
-    }
-#endif
-    const ClosingColumns c = c_;
-    for (; k < to; ++k) {
-      close_one(k, sum_lane(k, whole_), h_, g_, c, sums_);
-      if constexpr (kDrift)
-        drift_one(k, h_, dt_, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
-    }
+  alignas(32) double lanes[3][4];
+  _mm256_store_pd(lanes[0], most.disp2);
+  _mm256_store_pd(lanes[1], most.speed2);
+  _mm256_store_pd(lanes[2], most.motion2);
+  for (std::size_t l = 0; l < 4; ++l) {
+    sums.disp2 = keep_larger(sums.disp2, lanes[0][l]);
+    sums.speed2 = keep_larger(sums.speed2, lanes[1][l]);
+    sums.motion2 = keep_larger(sums.motion2, lanes[2][l]);
   }
-  ClosingKick result() {
-#if DEM2D_VECTOR_GATHER
-    if (fours_) flush();
+}
 #endif
-    return sums_.result(dt_);
-  }
 
- private:
-#if DEM2D_VECTOR_GATHER
-  // The lanes into the sums, once, before the first particle past the whole eights.
-  void flush() {
-    if (flushed_) return;
-    flushed_ = true;
-    for (std::size_t half = 0; half < 2; ++half) {
-      _mm256_storeu_pd(sums_.checksum + 4 * half, checksum_[half]);
-      _mm256_storeu_pd(sums_.late_power + 4 * half, late_[half]);
-    }
-    alignas(32) double lanes[3][4];
-    _mm256_store_pd(lanes[0], most_.disp2);
-    _mm256_store_pd(lanes[1], most_.speed2);
-    _mm256_store_pd(lanes[2], most_.motion2);
-    for (std::size_t l = 0; l < 4; ++l) {
-      sums_.disp2 = keep_larger(sums_.disp2, lanes[0][l]);
-      sums_.speed2 = keep_larger(sums_.speed2, lanes[1][l]);
-      sums_.motion2 = keep_larger(sums_.motion2, lanes[2][l]);
-    }
-  }
-  bool fours_ = false, flushed_ = false;
-  FourMaxima most_;
-  __m256d checksum_[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
-  __m256d late_[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
-#endif
-  ClosingColumns c_;
-  double h_, dt_;
-  Vec2 g_;
-  std::size_t n_, whole_;
-  ClosingSums sums_;
-};
-
-// closing_kick (kDrift false) and closing_kick_drift (true): one range.
+// closing_kick (kDrift false) and closing_kick_drift (true): the closing pass over the owned
+// particles. With `four_at_a_time` (AVX-512), eight particles per iteration over the first whole
+// eights, the sums' lanes 0-3 and 4-7 in two registers each; then the rest one at a time into
+// lane 0 (ClosingSums' order either way).
 template <bool kDrift>
 ClosingKick close(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
-                  PairKinematics* mirror, bool four_at_a_time) {
-  ClosingRanges<kDrift> pass(p, x_build, dt, gravity, mirror, four_at_a_time);
-  pass.run(0, p.n_owned());
-  return pass.result();
+                  PairKinematics* mirror, [[maybe_unused]] bool four_at_a_time) {
+  const ClosingColumns c = closing_columns(p, x_build, mirror);
+  const double h = 0.5 * dt;
+  const std::size_t n = p.n_owned(), whole = n / kSumLanes * kSumLanes;
+  ClosingSums sums;
+  std::size_t k = 0;
+#if DEM2D_VECTOR_GATHER
+  if (four_at_a_time) {
+    FourMaxima most;
+    __m256d checksum[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+    __m256d late[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()};
+    for (; k < whole; k += 8) {
+      close_four<kDrift>(k, h, dt, gravity, c, most, checksum[0], late[0]);
+      close_four<kDrift>(k + 4, h, dt, gravity, c, most, checksum[1], late[1]);
+    }
+    flush_lanes(most, checksum, late, sums);
+  }
+#endif
+  for (; k < n; ++k) {
+    close_one(k, sum_lane(k, whole), h, gravity, c, sums);
+    if constexpr (kDrift)
+      drift_one(k, h, dt, c.x, c.v, c.a, c.th, c.w, c.al, c.f, c.tq, c.r, c.m, c.mat, c.mirror);
+  }
+  return sums.result(dt);
 }
 
 }  // namespace
@@ -435,110 +391,6 @@ ClosingKick closing_kick(ParticleStore& p, const Vec2* x_build, double dt, Vec2 
 ClosingKick closing_kick_drift(ParticleStore& p, const Vec2* x_build, double dt, Vec2 gravity,
                                PairKinematics* mirror, bool four_at_a_time) {
   return close<true>(p, x_build, dt, gravity, mirror, four_at_a_time);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Steps in one sweep
-
-// Past the caches each step streams the whole store twice (the pair loop, then the closing kick
-// and drift); a sweep of k steps streams it about once: each step's pair loop follows the one
-// before a few hundred particles behind, on lines still in the cache.
-//
-// A later step's evaluation uses the lists as they are, so they must hold every contact of its
-// positions, which are known only as the sweep goes. The step count decides to sweep only with a
-// wide margin: the last round's bound on the displacement since the build at the coming drift's
-// end, plus four times that drift's largest move for each further step, plus a fiftieth of the
-// skin, must not make a rebuild due at the sweep's last step. After the sweep each step's round
-// but the last checks the true bound (a particle would have had to speed up fourfold in a step):
-// if it fails, the run stops with an internal error rather than go on unexact.
-bool VelocityVerlet::can_sweep(const StepStages& s, int steps) const {
-  if (!ahead_ || rebuild_next_ || ghosts_ahead_ || !elastic_cleared_) return false;
-  const double skin = s.rebuilds().skin();
-  const double further = static_cast<double>(steps - 1);
-  // The walls steps + 1 steps on: where the last early step's round will look from.
-  return !s.rebuilds().due(bound_ + 4.0 * further * drift_move_ + 0.02 * skin, s.walls(), s.time(),
-                           static_cast<double>(steps + 1) * dt_);
-}
-
-namespace {
-
-// What the kernel's sweep hands over: a step's particles closed and drifted to the next step
-// (the last step's drifted only when it runs ahead); the walls at each step's pose, set before
-// the sweep (the clock is left at the last step).
-template <bool kLastDrift>
-class SweepClosing final : public StepSweep {
- public:
-  SweepClosing(StepStages& s, int steps, const Vec2* x_build, double dt, Vec2 gravity,
-               PairKinematics* mirror)
-      : steps_(steps),
-        last_(s.particles(), x_build, dt, gravity, kLastDrift ? mirror : nullptr, true) {
-    early_.reserve(static_cast<std::size_t>(steps - 1));
-    for (int k = 0; k < steps; ++k) {
-      if (k + 1 < steps) early_.emplace_back(s.particles(), x_build, dt, gravity, mirror, true);
-      if (k > 0) s.clock_ahead(k + 1);
-      walls_[static_cast<std::size_t>(k)] = s.walls();
-    }
-  }
-  const Walls& walls(int step) const override { return walls_[static_cast<std::size_t>(step)]; }
-  void done(int step, std::size_t from, std::size_t to) override {
-    if (step + 1 < steps_)
-      early_[static_cast<std::size_t>(step)].run(from, to);
-    else
-      last_.run(from, to);
-  }
-  ClosingKick early(int step) { return early_[static_cast<std::size_t>(step)].result(); }
-  ClosingKick last() { return last_.result(); }
-
- private:
-  int steps_;
-  std::vector<ClosingRanges<true>> early_;
-  ClosingRanges<kLastDrift> last_;
-  std::array<Walls, kMaxSweepSteps> walls_;
-};
-
-}  // namespace
-
-SweepOutcomes Integrator::sweep_steps(StepStages&, int, bool) {
-  throw std::logic_error("sweep_steps: this integrator does not sweep steps");
-}
-
-SweepOutcomes VelocityVerlet::sweep_steps(StepStages& s, int steps, bool last_ahead) {
-  s.advance_clock();
-  const Vec2* x_build = s.rebuilds().positions_at_build();
-  PairKinematics* mirror = s.drift_mirror();
-  SweepOutcomes out;
-  const auto run = [&](auto& sweep) {
-    std::array<EvaluationTotals, kMaxSweepSteps - 1> early;
-    s.sweep_contact_forces(dt_, sweep,
-                           std::span(early.data(), static_cast<std::size_t>(steps - 1)));
-    for (int k = 0; k + 1 < steps; ++k) {
-      const auto u = static_cast<std::size_t>(k);
-      const ClosingKick c = sweep.early(k);
-      s.commit_early(dt_, c.late_loss, early[u], sweep.walls(k).drum_omega());
-      passes_.add(1);
-      ahead_ = true;
-      out[u] = end_of_step_round(s, c, early[u].max_overlap);
-      if (rebuild_next_ && !out[u].unstable)
-        throw std::logic_error(
-            "steps in one sweep: a later step's positions needed new neighbour lists (a "
-            "particle sped up more than the margin allows); run again with fewer particles per "
-            "rank or report this");
-    }
-    const ClosingKick c = sweep.last();
-    s.commit(dt_, c.late_loss);
-    passes_.add(1);
-    ahead_ = last_ahead;
-    out[static_cast<std::size_t>(steps - 1)] = end_of_step_round(s, c, s.totals().max_overlap);
-  };
-  if (last_ahead) {
-    SweepClosing<true> sweep(s, steps, x_build, dt_, gravity_, mirror);
-    run(sweep);
-    s.drift_mirror();  // the last drift wrote the owned lines: the next fill keeps them
-  } else {
-    SweepClosing<false> sweep(s, steps, x_build, dt_, gravity_, mirror);
-    run(sweep);
-  }
-  return out;
 }
 
 // The drift taken back (a failed step's report): x - dt v, v - a dt/2, w - alpha dt/2,
@@ -578,8 +430,6 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& 
   }
   if (!std::isfinite(reduce[1])) reduce[0] = 1.0;
   rebuild_next_ = s.rebuilds().due(reduce[1], s.walls(), s.time(), dt_);
-  bound_ = reduce[1];
-  drift_move_ = dt_ * std::sqrt(c.speed2);
   StepOutcome out{reduce[0] != 0.0, c.checksum, motion};
   if (out.unstable && motion > kMaxStepMotion) {  // name the particle (rare: only now)
     const ParticleStore& p = s.particles();

@@ -83,19 +83,6 @@ class StepStages {
   // `late_loss` (J) added to the dissipation the contact laws reported (Verlet's completion of
   // their work to the end-of-step velocity).
   virtual void commit(double dt, double late_loss) = 0;
-  // Steps in one sweep (VelocityVerlet::sweep_steps): the force evaluations of early.size() + 1
-  // steps, the closing kicks and drifts told through `sweep` (ContactKernel::evaluate_sweep);
-  // the totals of all steps but the last into `early`, the last's become totals(). The walls at
-  // each step's pose come from the sweep (clock_ahead).
-  virtual void sweep_contact_forces(double dt, StepSweep& sweep,
-                                    std::span<EvaluationTotals> early) = 0;
-  // The clock and the walls `steps` steps past the step count (advance_clock: 1), which is not
-  // advanced.
-  virtual void clock_ahead(int steps) = 0;
-  // commit() for a step of a sweep but its last, with its totals and the drum's speed at its
-  // time.
-  virtual void commit_early(double dt, double late_loss, const EvaluationTotals& totals,
-                            double drum_omega) = 0;
 
  protected:
   ~StepStages() = default;
@@ -124,9 +111,6 @@ struct StepOutcome {
   double shift_mine = 0.0;
   std::int64_t shift_id = -1;
 };
-
-// The round verdicts of the steps of one sweep (Integrator::sweep_steps), in order.
-using SweepOutcomes = std::array<StepOutcome, kMaxSweepSteps>;
 
 // Passes of force evaluation per step (always 1 for Verlet).
 struct PassCounter {
@@ -168,14 +152,6 @@ class Integrator {
   // After particles were born or removed between steps and the forces evaluated anew at the
   // step's end state.
   virtual void after_population_change() {}
-  // Whether the next `steps` steps may run in one sweep over the store (sweep_steps): the store
-  // is one drift ahead, no rebuild is due, and the lists stay valid through the last of them
-  // with a wide margin (Verlet only).
-  virtual bool can_sweep(const StepStages& /*s*/, int /*steps*/) const { return false; }
-  // The next `steps` steps (2 to kMaxSweepSteps) in one sweep: the same bits as that many step()
-  // calls, all but the last running ahead (VelocityVerlet); the last leaves the store one drift
-  // ahead when `last_ahead`. The steps' round verdicts, in order.
-  virtual SweepOutcomes sweep_steps(StepStages& s, int steps, bool last_ahead);
   const PassCounter& passes() const { return passes_; }
   PassCounter& passes() { return passes_; }
 
@@ -252,8 +228,6 @@ class VelocityVerlet final : public Integrator {
   }
   void allow_run_ahead(bool allowed) override { run_ahead_allowed_ = allowed; }
   bool ran_ahead() const override { return ahead_; }
-  bool can_sweep(const StepStages& s, int steps) const override;
-  SweepOutcomes sweep_steps(StepStages& s, int steps, bool last_ahead) override;
   void step_back(ParticleStore& p) override;
   void state_replaced() override { after_population_change(); }
 
@@ -269,9 +243,6 @@ class VelocityVerlet final : public Integrator {
   bool rebuild_next_ = true;        // decided by the previous step's round
   bool ghosts_ahead_ = false;       // the ghosts already hold this step's drifted state
   bool elastic_cleared_ = false;    // the owned elastic forces are zero (closing_kick)
-  // The last round's bound on the displacement since the build at the coming drift's end, and
-  // the coming drift's largest move (can_sweep).
-  double bound_ = 0.0, drift_move_ = 0.0;
   // In parallel: the state the halo sources will drift to in the next step (their entries
   // only), sent to the ghosts in the end-of-step round.
   std::vector<FieldBase*> next_registry_;

@@ -269,87 +269,6 @@ bool Simulation::may_run_ahead(std::int64_t k, bool end_observed) const {
          k % kBackupSteps != 0;
 }
 
-int Simulation::advance(const std::function<bool(int)>& observed) {
-  // Every step of a sweep but its last must run ahead; the last may.
-  const std::int64_t base = step_;
-  const int most = most_steps_now();
-  int steps = 1;
-  while (steps < most && may_run_ahead(base + steps, observed(steps))) ++steps;
-  while (steps > 1 && !integrator_->can_sweep(*this, steps)) --steps;
-  if (steps == 1) {
-    step(observed(1));
-    if (choice_ && most > 0) choice_->stepped(1);
-    return 1;
-  }
-  population_planned_ = false;
-  const SweepOutcomes out =
-      integrator_->sweep_steps(*this, steps, may_run_ahead(base + steps, observed(steps)));
-  steps_paired_ += steps;
-  ++sweeps_of_[static_cast<std::size_t>(steps)];
-  for (int k = 0; k + 1 < steps; ++k) {
-    const SweepOutcomes::value_type& outcome = out[static_cast<std::size_t>(k)];
-    if (!outcome.unstable) {
-      ++step_;
-      ++steps_run_ahead_;
-      continue;
-    }
-    // Named at its own step and time, with its own totals.
-    const EvaluationTotals last_totals = contacts_.totals();
-    const double t = time_;
-    time_ = static_cast<double>(step_ + 1) * dt_;
-    contacts_.restore_totals(sweep_totals_[static_cast<std::size_t>(k)]);
-    const auto last_step_again = [&] {
-      contacts_.restore_totals(last_totals);
-      time_ = t;
-    };
-    try {
-      after_step(outcome, true);
-    } catch (const UnstableError&) {  // the snapshot shows the last step's state, at its step
-      last_step_again();
-      step_ = base + steps;
-      throw;
-    }
-    last_step_again();
-  }
-  after_step(out[static_cast<std::size_t>(steps - 1)], integrator_->ran_ahead());
-  if (choice_) choice_->stepped(steps);
-  return steps;
-}
-
-// The most steps advance() may sweep now (1: single steps), by the fixed rule or the timed
-// choice; 0 where sweeps are not allowed at all (the timed choice is then not told of the step).
-int Simulation::most_steps_now() {
-  const std::size_t owned = particles_.n_owned();
-  if (!baseline_taken_ || particles_.size() != owned || domain_->size() != 1 || grinding_ ||
-      spectra_ || !contacts_.pairs_steps())
-    return 0;
-  if (!choose_sweeps_) return owned >= pair_steps_from_ ? sweep_steps_ : 1;
-  if (owned < choose_from_) return 0;
-  if (!choice_) {
-    // Blocks of about 2e6 particle-steps (70 ms at 35 ns per particle-step), whole sweeps.
-    const int block =
-        choice_block_steps_ > 0
-            ? choice_block_steps_
-            : std::max(2 * sweep_steps_, static_cast<int>((2000000 / owned + 7) / 8 * 8));
-    choice_.emplace(block, choice_clock_ ? choice_clock_ : thread_cpu_seconds);
-  }
-  return choice_->next_sweeps() ? std::min(sweep_steps_, choice_->steps_left()) : 1;
-}
-
-void Simulation::set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock) {
-  choose_sweeps_ = true;
-  choose_from_ = n;
-  choice_block_steps_ = block_steps;
-  choice_clock_ = std::move(clock);
-  choice_.reset();
-}
-
-void Simulation::set_sweep_steps(int steps) {
-  if (steps < 2 || steps > kMaxSweepSteps)
-    throw std::invalid_argument("set_sweep_steps: 2 to " + std::to_string(kMaxSweepSteps));
-  sweep_steps_ = steps;
-}
-
 // Velocity Verlet plans the population step within the step (population_changes), the
 // iterative scheme here.
 bool Simulation::population_changes() {
@@ -391,13 +310,9 @@ double Simulation::local_energy() const {
 }
 
 void Simulation::run_until(double t_end) {
-  while (time_ + 0.5 * dt_ < t_end) {
-    // The loop's own test for the next steps, on the time they will set (advance_clock).
-    const auto ends = [&](int k) {
-      return static_cast<double>(step_ + k) * dt_ + 0.5 * dt_ >= t_end;
-    };
-    advance(ends);
-  }
+  // The loop's own test for the next step's end, on the time it will set (advance_clock).
+  while (time_ + 0.5 * dt_ < t_end)
+    step(/*end_observed=*/static_cast<double>(step_ + 1) * dt_ + 0.5 * dt_ >= t_end);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -405,11 +320,6 @@ void Simulation::run_until(double t_end) {
 
 void Simulation::advance_clock() {
   time_ = static_cast<double>(step_ + 1) * dt_;
-  walls_.update(time_);
-}
-
-void Simulation::clock_ahead(int steps) {
-  time_ = static_cast<double>(step_ + steps) * dt_;
   walls_.update(time_);
 }
 
@@ -499,18 +409,6 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
     e[k] = {};
   }
   contacts_.evaluate(particles_, walls_, dt);
-}
-
-void Simulation::sweep_contact_forces(double dt, StepSweep& sweep,
-                                      std::span<EvaluationTotals> early) {
-  contacts_.evaluate_sweep(particles_, dt, sweep, early);
-  std::copy(early.begin(), early.end(), sweep_totals_.begin());
-}
-
-void Simulation::commit_early(double dt, double late_loss, const EvaluationTotals& totals,
-                              double drum_omega) {
-  contacts_.commit();
-  book(totals, dt, late_loss, drum_omega);
 }
 
 void Simulation::book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega) {

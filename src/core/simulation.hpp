@@ -35,7 +35,6 @@
 #include "core/scene.hpp"
 #include "core/spatial_order.hpp"
 #include "core/state_backup.hpp"
-#include "core/sweep_choice.hpp"
 #include "core/time_scales.hpp"
 #include "core/walls.hpp"
 
@@ -100,34 +99,6 @@ class Simulation final : private StepStages {
   // ahead (the closing kick fused with the next kick-drift, the same bits; integrators.hpp).
   // The simulation itself keeps the state whole at the steps it checks or backs up.
   void step(bool end_observed = true);
-  // One step, or several in one sweep over the store when that is allowed and pays (at most
-  // sweep_steps(); one rank, Velocity Verlet, histories written in place, no ore models or
-  // collision spectra; integrators.cpp, "Steps in one sweep"): the same bits as step() called
-  // that many times. Whether sweeps pay is measured on the run from kChooseSweepsFrom owned
-  // particles (core/sweep_choice.hpp: blocks of each mode timed in turn by the thread's CPU
-  // clock); below it steps are single. `observed(k)` says whether anything reads the particles
-  // at the end of the k-th step from now (k = 1: the next step; as step()'s `end_observed`); a
-  // sweep ends at the first such step. Returns the steps taken.
-  int advance(const std::function<bool(int)>& observed);
-  // A fixed rule instead of the timed choice: sweeps whenever allowed from n owned particles (0:
-  // always; a huge value: never). Tests and benches use it to compare the modes.
-  void set_pair_steps_from(std::size_t n) {
-    pair_steps_from_ = n;
-    choose_sweeps_ = false;
-    choice_.reset();
-  }
-  // The timed choice from n owned particles on, its blocks of `block_steps` steps timed by
-  // `clock` (seconds; tests give their own).
-  void set_sweep_choice(std::size_t n, int block_steps, SweepChoice::Clock clock);
-  // The timed choice, once it has started (null before and with a fixed rule).
-  const SweepChoice* sweep_choice() const { return choice_ ? &*choice_ : nullptr; }
-  // The most steps advance() takes in one sweep (2 to kMaxSweepSteps; default kSweepSteps).
-  void set_sweep_steps(int steps);
-  int sweep_steps() const { return sweep_steps_; }
-  // Steps so far that ran in sweeps of several steps (each step counted), and the sweeps of
-  // exactly `steps` steps.
-  std::int64_t steps_paired() const { return steps_paired_; }
-  std::int64_t sweeps_of(int steps) const { return sweeps_of_.at(static_cast<std::size_t>(steps)); }
   // Steps until t_end; the state is whole when it returns.
   void run_until(double t_end);
   // Whether steps may run ahead at all (default on): off, every step ends whole (tests compare).
@@ -195,18 +166,11 @@ class Simulation final : private StepStages {
   PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
   bool population_changes() override;
   void commit(double dt, double late_loss) override;
-  void sweep_contact_forces(double dt, StepSweep& sweep,
-                            std::span<EvaluationTotals> early) override;
-  void clock_ahead(int steps) override;
-  void commit_early(double dt, double late_loss, const EvaluationTotals& totals,
-                    double drum_omega) override;
   // The ledger's share of one step's totals.
   void book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega);
   // Whether step k may leave the store one drift ahead: its end is not observed, nor the run's
   // last, nor checked or backed up.
   bool may_run_ahead(std::int64_t k, bool end_observed) const;
-  // The most steps advance() may take in one sweep now (0: no sweep allowed, 1: single steps).
-  int most_steps_now();
   // After a step: its count, the guard verdict, the energy check and the backup (step()).
   void after_step(const StepOutcome& outcome, bool ran_ahead);
 
@@ -265,25 +229,6 @@ class Simulation final : private StepStages {
   std::int64_t builds_before_ = 0;  // neighbour builds before a restart
   bool run_ahead_ = true;
   std::int64_t steps_run_ahead_ = 0;
-  // At most eight steps per sweep, measured in interleaved blocks of one process
-  // (bench/sweep_modes; docs/performance.md, thirteenth session): on the deposited 1e5 bed eight
-  // steps take 0.93 of four steps' time. Whether to sweep at all is timed on the run from
-  // kChooseSweepsFrom owned particles (fourteenth session): below 1e5 sweeps win only while the
-  // host's caches are contended (the dense 3e4 bed: 0.83-1.10 of single steps' time, 1e4: 1.06)
-  // and lose on a sparse 40 000-ball waterfall (1.08-1.21); at 1e5 and above they win.
-  static constexpr std::size_t kChooseSweepsFrom = 20000;
-  static constexpr int kSweepSteps = 8;
-  bool choose_sweeps_ = true;
-  std::size_t choose_from_ = kChooseSweepsFrom;
-  int choice_block_steps_ = 0;  // 0: from the owned count (advance)
-  SweepChoice::Clock choice_clock_;
-  std::optional<SweepChoice> choice_;  // started by the first step that may sweep
-  std::size_t pair_steps_from_ = 0;    // with a fixed rule
-  int sweep_steps_ = kSweepSteps;
-  std::int64_t steps_paired_ = 0;
-  std::array<std::int64_t, kMaxSweepSteps + 1> sweeps_of_{};
-  // The totals of the last sweep's steps but its last (their guards).
-  std::array<EvaluationTotals, kMaxSweepSteps - 1> sweep_totals_;
   bool population_planned_ = false;  // this step's population step planned by the integrator
   // Last known good state, saved every kBackupSteps steps and after every rebuild.
   static constexpr std::int64_t kBackupSteps = 1000;
