@@ -180,7 +180,8 @@ std::optional<LifterOverlap> lifter_overlap(const DrumSpec& drum, Vec2 x, double
       const double dx = std::max({top - s, s - drum.radius, 0.0});
       const double dy = std::max(std::abs(t) - 0.5 * lifter.width, 0.0);
       const bool inside = dx == 0.0 && dy == 0.0;
-      if (inside || dx * dx + dy * dy < r * r) return LifterOverlap{l, k, inside};
+      if (inside || dx * dx + dy * dy < r * r)
+        return LifterOverlap{l, k, inside, std::sqrt(dx * dx + dy * dy)};
     }
   }
   return std::nullopt;

@@ -60,11 +60,12 @@ void check_memory(const Scene& scene, double available);
 // Lifters
 
 // A disc that reaches into a lifter bar at t = 0: which [[drum.lifter]] and which of its bars,
-// and whether its centre lies inside the bar.
+// whether its centre lies inside the bar, and how far the centre is from the bar (0 inside).
 struct LifterOverlap {
   std::size_t lifter = 0;
   int bar = 0;
   bool inside = false;
+  double distance = 0.0;  // m
 };
 
 // The first lifter bar that a disc at x of radius r overlaps (closer to the bar than r, or

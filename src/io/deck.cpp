@@ -682,14 +682,19 @@ struct FileRows {
 };
 
 // Checks the particles the deck places itself, the [[particle]] tables and then the rows of the
-// [[fill]] files (as Scene::particles holds them), before step 1: inside the drum clear of its
-// shell, clear of the lifter bars, and apart from each other. A particle whose disc reaches the
-// shell or a bar, or overlaps another by more than kPlacementOverlap of the smaller radius (a
-// resting Hertz contact overlaps well under 1 %: a packing saved from a settled run passes), is
-// bad input at its table's position, or at its CSV row (at most kMaxCsvErrors rows of a file,
-// then a count of the others).
+// [[fill]] files (as Scene::particles holds them), before step 1: inside the drum, clear of the
+// lifter bars, and apart from each other, each up to the one tolerance kPlacementOverlap. A
+// particle that overlaps the drum's shell (circle or polygon) or a lifter bar by more than
+// kPlacementOverlap of its radius, or another particle by more than kPlacementOverlap of the
+// smaller radius, is bad input at its table's position, or at its CSV row (at most
+// kMaxCsvErrors rows of a file, then a count of the others).
 class Placement {
  public:
+  // The overlap a particle may start with, as a fraction of its radius (of the smaller one for
+  // a pair): the same for pairs, the shell and the lifter bars, so that a packing saved from a
+  // settled run, by dem2d or another code, passes whole (a resting Hertz contact overlaps well
+  // under 1 %: 200 steel balls of 8 mm settled by dem2d rest on the shell with at most 0.01 %).
+  // The first step pushes such a contact apart like any other.
   static constexpr double kPlacementOverlap = 0.05;
 
   Placement(const Scene& scene, Diagnostics& diag, const std::vector<const toml::table*>& tables,
@@ -710,30 +715,49 @@ class Placement {
   }
 
  private:
-  // Inside the drum's circle or polygon, by the particle's clearance from the nearest side.
+  // Inside the drum's circle or polygon, by the particle's clearance from the nearest side: an
+  // overlap with the shell (radius - clearance) of at most kPlacementOverlap of the radius.
   bool in_drum(std::size_t i) {
     const DrumSpec& d = scene_.drum;
     const ParticleSpec& p = scene_.particles[i];
     if (!d.present) return false;
     const double clearance = shell_clearance(d, p.position);
-    if (clearance >= p.radius) return true;
-    report(i,
-           fmt::format("the particle (radius {:g} m) {} the drum (radius {:g} m about [{:g}, "
-                       "{:g}]{}); place it at least its radius inside the shell",
-                       p.radius, clearance <= -p.radius ? "lies outside" : "straddles the shell of",
-                       d.radius, d.center.x, d.center.y,
-                       d.sides >= 3 ? fmt::format(", {} sides", d.sides) : std::string()));
+    const double overlap = p.radius - clearance;
+    if (overlap <= kPlacementOverlap * p.radius) return true;
+    const std::string drum =
+        fmt::format("the drum (radius {:g} m about [{:g}, {:g}]{})", d.radius, d.center.x,
+                    d.center.y, d.sides >= 3 ? fmt::format(", {} sides", d.sides) : std::string());
+    report(i, clearance <= -p.radius
+                  ? fmt::format("the particle (radius {:g} m) lies outside {}; place it at least "
+                                "its radius inside the shell",
+                                p.radius, drum)
+                  : fmt::format("the particle (radius {:g} m) overlaps the shell of {} by {:.3g} "
+                                "% of its radius; {}",
+                                p.radius, drum, 100.0 * overlap / p.radius, allowed()));
     return false;
   }
 
+  // Clear of the bars: nearer to none than its radius less kPlacementOverlap of it.
   void clear_of_lifters(std::size_t i) {
     const ParticleSpec& p = scene_.particles[i];
-    const auto bar = lifter_overlap(scene_.drum, p.position, p.radius);
+    const double reach = p.radius - kPlacementOverlap * p.radius;
+    const auto bar = lifter_overlap(scene_.drum, p.position, reach);
     if (!bar) return;
-    report(i,
-           fmt::format("the particle (radius {:g} m) {} bar {} of drum.lifter[{}] (the bars "
-                       "at the drum's initial angle); place it clear of the lifters",
-                       p.radius, bar->inside ? "lies inside" : "overlaps", bar->bar, bar->lifter));
+    const std::string which = fmt::format(
+        "bar {} of drum.lifter[{}] (the bars at the drum's initial angle)", bar->bar, bar->lifter);
+    report(i, bar->inside
+                  ? fmt::format("the particle (radius {:g} m) lies inside {}; place it clear of "
+                                "the lifters",
+                                p.radius, which)
+                  : fmt::format("the particle (radius {:g} m) overlaps {} by {:.3g} % of its "
+                                "radius; {}",
+                                p.radius, which, 100.0 * (p.radius - bar->distance) / p.radius,
+                                allowed()));
+  }
+
+  // The tolerance, as every overlap message states it.
+  static std::string allowed() {
+    return fmt::format("at most {:g} % is allowed at the start", 100.0 * kPlacementOverlap);
   }
 
   // Pairs closer than allowed, found on a grid of cells as wide as the largest diameter, and
@@ -782,9 +806,8 @@ class Placement {
     const double s = smaller(i, j);
     report(j, gap <= 1e-9 * s
                   ? fmt::format("coincides with {}; give each particle its own place", name(i))
-                  : fmt::format("overlaps {} by {:.3g} % of the smaller radius; at most {:g} % "
-                                "is allowed at the start",
-                                name(i), 100.0 * overlap(i, j) / s, 100.0 * kPlacementOverlap));
+                  : fmt::format("overlaps {} by {:.3g} % of the smaller radius; {}", name(i),
+                                100.0 * overlap(i, j) / s, allowed()));
   }
 
   // The file whose rows hold particle i (i past the tables).

@@ -483,9 +483,10 @@ TEST(DeckErrors, TomlSyntaxErrorHasItsPosition) {
             "'\\n' (the line: [run)");
 }
 
-// Placement before step 1: a particle outside the drum, straddling its polygonal shell,
-// coinciding with another or overlapping it by more than 5 % of the smaller radius is bad input
-// at its position; a particle inside the circle but outside the polygon is caught by the sides.
+// Placement before step 1: a particle outside the drum, overlapping its polygonal shell by more
+// than 5 % of its radius, coinciding with another or overlapping it by more than 5 % of the
+// smaller radius is bad input at its position; a particle inside the circle but outside the
+// polygon is caught by the sides.
 TEST(DeckErrors, ParticlesOutsideTheDrumOrOnEachOtherAreRefused) {
   std::string deck = R"([[material]]
 name = "steel"
@@ -511,8 +512,8 @@ material = "steel"
   EXPECT_TRUE(has_message(
       messages,
       "deck.in:25:12: error: particle[3].position = [0.0, -0.9]: the particle (radius "
-      "0.1 m) straddles the shell of the drum (radius 1 m about [0, 0], 8 sides); place "
-      "it at least its radius inside the shell"));
+      "0.1 m) overlaps the shell of the drum (radius 1 m about [0, 0], 8 sides) by 7.61 % of "
+      "its radius; at most 5 % is allowed at the start"));
   EXPECT_TRUE(
       has_message(messages,
                   "deck.in:29:12: error: particle[4].position = [0.0, 3.0]: the particle (radius "
@@ -523,8 +524,8 @@ material = "steel"
   EXPECT_TRUE(
       has_message(messages,
                   "deck.in:33:12: error: particle[5].position = [0.7853, 0.3253]: the particle "
-                  "(radius 0.1 m) straddles the shell of the drum (radius 1 m about [0, 0], 8 "
-                  "sides); place it at least its radius inside the shell"));
+                  "(radius 0.1 m) overlaps the shell of the drum (radius 1 m about [0, 0], 8 "
+                  "sides) by 26.1 % of its radius; at most 5 % is allowed at the start"));
   // particle[6] at [0, 0.5] and particle[7] 0.1985 from it overlap by 0.75 %: a resting contact,
   // accepted. particle[2] overlaps both particle[0] and particle[1].
   EXPECT_EQ(messages.size(), 6u) << fmt::format("{}", fmt::join(messages, "\n"));
