@@ -53,8 +53,8 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.hpp"
 #include "blocks.hpp"
+#include "core/simulation.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "parallel/mpi_domain.hpp"

@@ -5,11 +5,12 @@
 // deposited_packing, as bench/throughput's deposited section: steel with e = 0.1 and mu_s = 0.5,
 // the drum still, dt = 1e-6 s), each warmed by 50 steps, and steps them in blocks that take the
 // sizes in turn, the order rotated each round. Each size steps as the program would (step(), the
-// closing kick fused with the next drift but at the block's last step). A block is about --budget particle-steps
-// (its steps a multiple of 8, at least 8), timed by the thread's CPU clock and compared with the
-// first size's block of the same round: a slow minute of the host falls on neighbouring blocks of
-// every size alike. bench/size_rounds.py runs each size as its own process instead, where the same
-// binary moved by up to 20 % from one process to the next (docs/performance.md).
+// closing kick fused with the next drift but at the block's last step). A block is about --budget
+// particle-steps (its steps a multiple of 8, at least 8), timed by the thread's CPU clock and
+// compared with the first size's block of the same round: a slow minute of the host falls on
+// neighbouring blocks of every size alike. bench/size_rounds.py runs each size as its own process
+// instead, where the same binary moved by up to 20 % from one process to the next
+// (docs/performance.md).
 //
 //   size_blocks [--particles 10000,30000,100000,300000,1000000] [--rounds R] [--budget P]
 //               [--bound B] [--sort auto|always|never] [--results DIR] [--csv NAME] [--no-plot]

@@ -58,6 +58,7 @@
 #include <string>
 #include <vector>
 
+#include "core/disc.hpp"
 #include "core/errors.hpp"
 #include "core/particles.hpp"
 #include "core/simulation.hpp"
@@ -134,7 +135,7 @@ Hertz hertz_closed_form() {
   Hertz h;
   h.e_star = 1.0 / (2.0 * (1.0 - nu * nu) / kYoung);
   h.r_eff = 0.5 * kRadius;
-  h.m_eff = 0.5 * dem2d::ParticleStore::sphere_mass(kRadius, kDensity);
+  h.m_eff = 0.5 * dem2d::Disc::mass(kRadius, kDensity);
   const double v = 2.0 * kSpeed;
   h.delta_max = std::pow(15.0 * h.m_eff * v * v / (16.0 * h.e_star * std::sqrt(h.r_eff)), 0.4);
   const double beta = std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);

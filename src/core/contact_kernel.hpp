@@ -15,6 +15,7 @@
 #include "core/contact_batch.hpp"
 #include "core/contact_engine.hpp"
 #include "core/contact_models.hpp"
+#include "core/disc.hpp"
 #include "core/pair_gather.hpp"
 
 namespace dem2d::kernels {
@@ -70,6 +71,10 @@ inline constexpr std::size_t kScatterPrefetchFrom = 50000;
 // they scatter.
 template <class Model>
 class Kernel final : public ContactKernel {
+  // The particle shape's narrow phase and inertia (core/disc.hpp); the gather is the disc's.
+  using Shape = Disc;
+  static_assert(Shape::kArmsAlongNormal,
+                "the torques and surface velocities below take arms along n");
   using Coeffs = typename Model::template Coeffs<double>;
   static constexpr std::size_t W = Model::kHistoryWidth;
   static_assert(W <= kMaxHistorySlots, "raise kMaxHistorySlots");
@@ -326,7 +331,7 @@ template <class Model>
 [[gnu::noinline]] void Kernel<Model>::release_wall(const ParticleStore& p, const Walls& walls,
                                                    std::int32_t i, std::int32_t element, double dt,
                                                    const double* h) {
-  const WallGeometry g = walls.geometry(element, p.pos[i], p.radius[i]);
+  const WallGeometry g = Disc::wall(walls, element, p.pos[i], p.radius[i]);
   const WallElement& e = walls.elements()[element];
   const Vec2 v_rel = p.vel[i] - walls.velocity_at(e.body, g.point);
   const double delta_old = g.delta - dt * dot(v_rel, g.n);  // closing along n, from i to the wall
@@ -439,20 +444,19 @@ template <class Model>
 void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated,
                                    EightLanes& elastic, Pack& overlap) {
   for (std::size_t c = 0; c < padded(n); c += kPackSize) {
-    const Pack dist = vsqrt(load(b_.dist2, c));
-    const Pack inv = 1.0 / dist;
-    const Pack nx = inv * load(b_.dx, c), ny = inv * load(b_.dy, c);
-    const Pack tx = -ny, ty = nx;
     const Pack ri = load(b_.r_i, c), rj = load(b_.r_j, c);
+    const PairContactT<Pack> g =
+        Shape::pair(load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj);
+    const Pack nx = g.nx, ny = g.ny;
+    const Pack tx = -ny, ty = nx;
     const Pack mi = load(b_.m_i, c), mj = load(b_.m_j, c);
-    const Pack rsum = ri + rj;
     KinematicsT<Pack> kin;
-    kin.delta = rsum - dist;
-    kin.r_eff = ri * rj / rsum;
+    kin.delta = g.delta;
+    kin.r_eff = g.r_eff;
     kin.m_eff = mi * mj / (mi + mj);
     if constexpr (Model::Rolling::kNeedsInertia) {
-      // I + m r^2 = 7/5 m r^2 about the contact point; harmonic mean of the two bodies.
-      const Pack ia = 1.4 * mi * ri * ri, ib = 1.4 * mj * rj * rj;
+      // About the contact point; harmonic mean of the two bodies.
+      const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
       kin.i_eff = ia * ib / (ia + ib);
     }
     const Pack spin = load(b_.spin, c);
@@ -461,8 +465,9 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipa
     const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
     const ContactForceT<Pack>& cf = out.law;
     const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
-    const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : ri;
-    const Pack arm_j = Model::Law::kTorqueArmIsReff ? kin.r_eff : rj;
+    // Arms along the normal (Shape::kArmsAlongNormal): arm x force = arm f_t.
+    const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_i;
+    const Pack arm_j = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_j;
     Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
     Pack diss = cf.dissipated, el = cf.elastic;
     if constexpr (Model::Rolling::kActive) {
@@ -615,18 +620,18 @@ std::size_t Kernel<Model>::gather_walls(const ParticleStore& p, const Walls& wal
     const WallElement& e = elements[wl.element[k]];
     WallGeometry g;
     if (e.kind == WallKind::kCircle) {
-      // The circle's test and geometry of Walls::touches and Walls::geometry, with the cheap
+      // The circle's test and geometry of Disc::touches_wall and Disc::wall, with the cheap
       // test's distance kept for the geometry.
       const Vec2 c = walls.circle_center(e);
       const Vec2 d = x[i] - c;
       const double d2 = norm2(d);
-      if (clear_inside_circle(e.radius, r[i], d2)) continue;
-      g = circle_geometry(c, e.radius, d, std::sqrt(d2), r[i]);
+      if (Disc::clear_inside_circle(e.radius, r[i], d2)) continue;
+      g = Disc::inside_circle(c, e.radius, d, std::sqrt(d2), r[i]);
     } else {
       // Most candidates do not touch: the cheap test skips the square root and division of the
       // full geometry (5 % of the waterfall's time, measured A/B with bench/throughput).
-      if (!walls.touches(wl.element[k], x[i], r[i])) continue;
-      g = walls.geometry(wl.element[k], x[i], r[i]);
+      if (!Disc::touches_wall(walls, wl.element[k], x[i], r[i])) continue;
+      g = Disc::wall(walls, wl.element[k], x[i], r[i]);
     }
     if (g.delta <= 0.0) continue;  // the cheap test and the geometry may differ in the last bit
     const Vec2 vw = walls.velocity_at(e.body, g.point);
@@ -662,7 +667,7 @@ void Kernel<Model>::evaluate_walls(std::size_t n, double dt) {
     kin.delta = load(wb_.delta, c);
     kin.r_eff = ri;
     kin.m_eff = mi;
-    if constexpr (Model::Rolling::kNeedsInertia) kin.i_eff = 1.4 * mi * ri * ri;
+    if constexpr (Model::Rolling::kNeedsInertia) kin.i_eff = Shape::contact_inertia(mi, ri);
     project_velocity(kin, load(wb_.vx, c), load(wb_.vy, c), nx, ny);
     kin.omega_rel = load(wb_.omega_rel, c);
     const ContactResponseT<Pack> out = respond(wb_, c, kin, dt);

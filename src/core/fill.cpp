@@ -8,6 +8,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/disc.hpp"
+#include "core/drum_geometry.hpp"
 #include "core/errors.hpp"
 #include "core/random.hpp"
 #include "core/validate.hpp"
@@ -111,15 +113,14 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
                              std::size_t f, double r_all_max) {
   const FillSpec& s = scene.fills[f];
   const bool needs_drum = s.region != FillRegion::kBox;
+  const DrumGeometry drum(scene.drum);
   const double spacing = 2.1 * s.radius_max;
   const double row = spacing * std::sqrt(3.0) / 2.0;
   Vec2 lo = s.box_min, hi = s.box_max;
   const Vec2 c = scene.drum.center;
   double r_in = 0.0;
   if (needs_drum) {
-    r_in = scene.drum.sides == 0
-               ? scene.drum.radius
-               : scene.drum.radius * std::cos(std::numbers::pi / scene.drum.sides);
+    r_in = drum.inner_radius();
     lo = c - Vec2{r_in, r_in};
     hi = c + Vec2{r_in, r_in};
   }
@@ -134,8 +135,8 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
       if (needs_drum && norm(p - c) > r_in - half) continue;
       bool clear = true;
       for (int e = 0; e < static_cast<int>(walls.elements().size()) && clear; ++e)
-        if (walls.geometry(e, p, half).delta > 0.0) clear = false;
-      if (clear && lifter_overlap(scene.drum, p, half)) clear = false;  // also inside a bar
+        if (Disc::wall(walls, e, p, half).delta > 0.0) clear = false;
+      if (clear && drum.bar_overlap(p, half)) clear = false;  // also inside a bar
       if (!clear || placed.overlaps(p, half, r_all_max)) continue;
       const std::uint64_t id = sites.size();
       const double u = random_uniform(scene.run.seed, kFillStream + 1000 + f, id);

@@ -6,6 +6,8 @@
 #include <numbers>
 
 #include "core/contact_models.hpp"
+#include "core/disc.hpp"
+#include "core/drum_geometry.hpp"
 #include "core/random.hpp"
 
 namespace dem2d {
@@ -18,13 +20,6 @@ constexpr std::uint64_t kStreamFragments = 0xf7a6'0000'0000'0002ULL;
 constexpr std::uint64_t kStreamFeed = 0xfeed'0000'0000'0003ULL;
 
 std::uint64_t stream(std::uint64_t seed, std::uint64_t which) { return mix64(seed ^ which); }
-
-// Kinetic, rotational and potential energy of one particle.
-double particle_energy(const ParticleStore& p, std::size_t k, Vec2 gravity) {
-  const double inertia = ParticleStore::sphere_inertia(p.mass[k], p.radius[k]);
-  return 0.5 * p.mass[k] * norm2(p.vel[k]) + 0.5 * inertia * p.omega[k] * p.omega[k] -
-         p.mass[k] * dot(gravity, p.pos[k]);
-}
 
 }  // namespace
 
@@ -41,8 +36,7 @@ Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& dom
   if (scene.feed.present && scene.drum.present) {
     // Candidate feed points: rings inside the drum clear of the shell and the lifters.
     const DrumSpec& d = scene.drum;
-    double reach = d.radius * (d.sides >= 3 ? std::cos(std::numbers::pi / d.sides) : 1.0);
-    for (const LifterSpec& l : d.lifters) reach = std::min(reach, d.radius - l.height);
+    const double reach = DrumGeometry(d).clear_radius();
     feed_reach_ = reach;
     candidates_.push_back(d.center);
     for (int ring = 1; ring <= 6; ++ring) {
@@ -79,7 +73,7 @@ bool Grinding::plan(double time, std::int64_t step, const ParticleStore& p,
 }
 
 bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Domain& domain,
-                     const std::function<void()>& before_change) {
+                     EnergyLedger& ledger, const std::function<void()>& before_change) {
   if (!plan_.tested_pairs.empty() || !plan_.tested_walls.empty()) {
     const std::size_t off = plan_.tracker_slot;
     const auto mark = [&](double* h) { h[TrackBreakage::kTested] = h[TrackBreakage::kPeak]; };
@@ -108,7 +102,7 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
       remove[k] = 2;
     }
     for (std::size_t k = 0; k < p.n_owned(); ++k)
-      if (remove[k] == 1) discharged_energy_ += particle_energy(p, k, scene_.run.gravity);
+      if (remove[k] == 1) ledger.discharged += mechanical_energy(p, k, scene_.run.gravity);
     p.remove_if(remove);
     break_parents(time, parents, p, domain);
     totals_.discharged_count += domain.sum(plan_.sieved);
@@ -119,7 +113,7 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
     before_change();
     births_from_ = next_id_;
   }
-  const bool fed = feed(time, p, domain);
+  const bool fed = feed(time, p, domain, ledger);
   return plan_.changes != 0 || fed;
 }
 
@@ -270,7 +264,7 @@ double Grinding::feed_radius() const {
 
 // One fed particle, where the charge is thinnest (or at the feed point), on the rank that owns
 // that place; false (on every rank) when no place is free: the feed waits 1 ms.
-bool Grinding::feed(double time, ParticleStore& p, Domain& domain) {
+bool Grinding::feed(double time, ParticleStore& p, Domain& domain, EnergyLedger& ledger) {
   const FeedSpec& f = scene_.feed;
   const double r = feed_radius();
   const std::vector<Vec2> points = f.has_point ? std::vector<Vec2>{f.point} : candidates_;
@@ -293,12 +287,12 @@ bool Grinding::feed(double time, ParticleStore& p, Domain& domain) {
     return false;
   }
   const double density = scene_.materials[static_cast<std::size_t>(feed_material_)].density;
-  const double mass = ParticleStore::sphere_mass(r, density);
+  const double mass = Disc::mass(r, density);
   if (domain.owns(points[best])) {
     p.clear_ghosts();
     const std::size_t k =
         p.add(next_id_, feed_material_, r, density, points[best], f.velocity, 0.0);
-    fed_energy_ += particle_energy(p, k, scene_.run.gravity);
+    ledger.fed += mechanical_energy(p, k, scene_.run.gravity);
   }
   ++next_id_;
   totals_.fed_count += 1;

@@ -34,6 +34,7 @@
 
 #include "core/contact_engine.hpp"
 #include "core/domain.hpp"
+#include "core/energy_ledger.hpp"
 #include "core/particles.hpp"
 #include "core/scene.hpp"
 
@@ -65,7 +66,6 @@ struct GrindingState {
   std::int64_t next_id = 0, births_from = -1;
   double next_feed_try = 0.0;
   GrindingTotals totals;
-  double rank_fed_energy = 0.0, rank_discharged_energy = 0.0;
 };
 
 class Grinding {
@@ -82,36 +82,28 @@ class Grinding {
   // contacts tested, damage, breaks, product, feed; collective). Returns true, on every rank
   // alike, when the population changed; the caller then rebuilds and calls exclude_births().
   // `before_change` is called just before the store first changes (not at all in a step that
-  // changes nothing).
+  // changes nothing). The energy of the particles fed and discharged goes into `ledger`.
   bool plan(double time, std::int64_t step, const ParticleStore& p, const ContactEngine& contacts,
             Domain& domain, bool evaluated);
   bool apply(double time, ParticleStore& p, ContactEngine& contacts, Domain& domain,
-             const std::function<void()>& before_change);
+             EnergyLedger& ledger, const std::function<void()>& before_change);
   // After the rebuild that follows a change: every listed contact of a particle born in it is
   // excluded (the next evaluation keeps the overlapping ones).
   void exclude_births(ContactEngine& contacts) const;
 
   const GrindingTotals& totals() const { return totals_; }
-  // This rank's energy carried in by the feed and out by the sieve since the start (J): kinetic,
-  // rotational and potential energy of the particles as they came and went.
-  double fed_energy() const { return fed_energy_; }
-  double discharged_energy() const { return discharged_energy_; }
   // This rank's records since the last call (the breakages of every rank on rank 0 only when
   // the caller gathers them; here: this rank's own).
   std::vector<BreakageRecord> take_breakages();
   std::vector<ProductRecord> take_product();
   std::int64_t next_id() const { return next_id_; }
   // Checkpoints: the state after a step (records already taken), and the same put back.
-  GrindingState state() const {
-    return {next_id_, births_from_, next_feed_try_, totals_, fed_energy_, discharged_energy_};
-  }
+  GrindingState state() const { return {next_id_, births_from_, next_feed_try_, totals_}; }
   void restore(const GrindingState& s) {
     next_id_ = s.next_id;
     births_from_ = s.births_from;
     next_feed_try_ = s.next_feed_try;
     totals_ = s.totals;
-    fed_energy_ = s.rank_fed_energy;
-    discharged_energy_ = s.rank_discharged_energy;
   }
   // The ore: the breakage material, else the feed's, else the sieve's.
   int ore_material() const {
@@ -155,7 +147,7 @@ class Grinding {
   void break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
                      Domain& domain);
   void sieve(double time, const ParticleStore& p);
-  bool feed(double time, ParticleStore& p, Domain& domain);
+  bool feed(double time, ParticleStore& p, Domain& domain, EnergyLedger& ledger);
   bool feed_due(double time) const;
   double feed_radius() const;
 
@@ -167,7 +159,6 @@ class Grinding {
   std::vector<Vec2> candidates_;   // feed: where the charge may be thinnest
   double feed_reach_ = 0.0;        // m from the drum centre clear of shell and lifters
   GrindingTotals totals_;
-  double fed_energy_ = 0.0, discharged_energy_ = 0.0;
   std::vector<BreakageRecord> breakages_;
   std::vector<ProductRecord> product_;
   Plan plan_;

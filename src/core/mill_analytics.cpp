@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include "core/drum_geometry.hpp"
+
 namespace dem2d {
 
 namespace {
@@ -17,18 +19,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // for the next step by then).
 bool touching(const ParticleStore& p, std::size_t k, Vec2 gravity) {
   return !(p.acc[k] == gravity) || p.alpha[k] != 0.0;
-}
-
-// The shell's inner radius where particles rest: the circle, or the polygon's inscribed circle.
-double shell_radius(const DrumSpec& drum) {
-  return drum.sides == 0 ? drum.radius : drum.radius * std::cos(std::numbers::pi / drum.sides);
-}
-
-// How far from the shell a particle may stand and still ride it: on the tallest lifter.
-double tallest_lifter(const DrumSpec& drum) {
-  double h = 0.0;
-  for (const LifterSpec& l : drum.lifters) h = std::max(h, l.height);
-  return h;
 }
 
 int bin_of(double angle_deg) {
@@ -177,9 +167,10 @@ ChargeShape measure_charge(const ParticleStore& p, const Walls& walls, const Dru
                            const Domain& domain, double time, Vec2 gravity) {
   const double omega = walls.drum_omega();
   const Frame f{drum.center, drum.speed < 0.0 ? -1.0 : 1.0};
-  const double shell = shell_radius(drum);
-  ChargeSums s =
-      charge_sums(p, f, shell, tallest_lifter(drum), omega, std::abs(omega) * shell, time, gravity);
+  const DrumGeometry geometry(drum);
+  const double shell = geometry.inner_radius();
+  ChargeSums s = charge_sums(p, f, shell, geometry.tallest_lifter(), omega, std::abs(omega) * shell,
+                             time, gravity);
   domain.sum(std::span<std::int64_t>(s.cover));
   domain.sum(std::span<double>(s.moments));
   const double r_max = domain.max(s.r_max);

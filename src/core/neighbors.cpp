@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include "core/disc.hpp"
+
 namespace dem2d {
 
 namespace {
@@ -301,7 +303,7 @@ void NeighborSearch::build_wall_pairs(const ParticleStore& p, const Walls& walls
       if (inside_clear && elements[e].body == walls.drum_body() &&
           elements[e].kind == WallKind::kSegment)
         continue;
-      if (walls.geometry(e, x, r).delta > -skin) {
+      if (Disc::wall(walls, e, x, r).delta > -skin) {
         fresh.particle.push_back(i);
         fresh.element.push_back(e);
         fresh.id.push_back(p.id[i]);

@@ -1,8 +1,9 @@
 #include "core/particles.hpp"
 
 #include <atomic>
-#include <numbers>
 #include <stdexcept>
+
+#include "core/disc.hpp"
 
 namespace dem2d {
 
@@ -18,10 +19,6 @@ std::size_t ParticleStore::bytes_per_particle() const {
   std::size_t b = 0;
   for (const FieldBase* f : registry_) b += f->bytes_per_item();
   return b;
-}
-
-double ParticleStore::sphere_mass(double r, double density) {
-  return 4.0 / 3.0 * std::numbers::pi * r * r * r * density;
 }
 
 void ParticleStore::enable_damage() {
@@ -58,10 +55,10 @@ std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, dou
   omega[i] = spin;
   alpha[i] = 0.0;
   radius[i] = r;
-  const double m = sphere_mass(r, density);
+  const double m = Disc::mass(r, density);
   mass[i] = m;
   inv_mass[i] = 1.0 / m;
-  inv_inertia[i] = 1.0 / sphere_inertia(m, r);
+  inv_inertia[i] = 1.0 / Disc::inertia(m, r);
   force[i] = {};
   torque[i] = 0.0;
   n_owned_ = i + 1;

@@ -173,10 +173,6 @@ class ParticleStore {
   void clear_ghosts();
   std::size_t add_ghosts(std::size_t n);
 
-  // Derived quantities of one particle.
-  static double sphere_mass(double r, double density);
-  static double sphere_inertia(double m, double r) { return 0.4 * m * r * r; }
-
  private:
   void resize_all(std::size_t n);
   std::size_t n_owned_ = 0;

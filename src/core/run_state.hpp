@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "core/energy_ledger.hpp"
 #include "core/grinding.hpp"
 #include "core/integrators.hpp"
 #include "core/mill_analytics.hpp"
@@ -38,18 +39,16 @@ struct RunState {
   // The time step and neighbour-list geometry chosen at the start (dt = "auto" and the skin
   // depend on the particles then, not on the particles now).
   double dt = 0.0, skin = 0.0, halo_width = 0.0;
-  // Energy ledger: this rank's share of the dissipated energy and the drive work since the
-  // start; the balance at the start (global).
-  double rank_dissipated = 0.0, rank_drive_work = 0.0;
+  // The energy ledger, this rank's share; the balance at the start (global).
+  EnergyLedger rank_ledger;
   bool baseline_taken = false;  // the balance at the start is taken as the first step starts
   double balance0 = 0.0, motion0 = 0.0, potential0 = 0.0, energy_floor = 0.0;
   PassCounter passes;
   std::int64_t neighbor_builds = 0;
   std::vector<GuardRecord> guards;
   GrindingState grinding;  // ore scenes only
-  // Mill analytics: this rank's share of the drum's drive work, the analysis window's samples
-  // (global), and the collision spectra summed over ranks (a resumed run gives them to rank 0).
-  double rank_drum_work = 0.0;
+  // Mill analytics: the analysis window's samples (global), and the collision spectra summed
+  // over ranks (a resumed run gives them to rank 0).
   std::vector<MillSample> mill_samples;
   std::vector<std::int64_t> spectra_counts;
   std::vector<double> spectra_energies;

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "core/disc.hpp"
 #include "core/errors.hpp"
 #include "core/fill.hpp"
 
@@ -72,7 +73,6 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
 void Simulation::set_up_analytics(const Resumption* resume) {
   mill_window_ = MillWindow(scene_.output.analysis_window);
   if (resume) {
-    drum_work_ = resume->state.rank_drum_work;
     mill_window_.restore(resume->state.mill_samples);
   }
   if (!scene_.output.collision_spectra) return;
@@ -163,8 +163,7 @@ void Simulation::resume_from(const Resumption& resume) {
   records.sort_unique();
   contacts_.adopt(records);
   rebuild();
-  dissipated_ = s.rank_dissipated;
-  drive_work_ = s.rank_drive_work;
+  ledger_ = s.rank_ledger;
   balance0_ = s.balance0;
   motion0_ = s.motion0;
   potential0_ = s.potential0;
@@ -182,8 +181,7 @@ RunState Simulation::run_state() const {
   s.dt = dt_;
   s.skin = rebuilds_.skin();
   s.halo_width = halo_width_;
-  s.rank_dissipated = dissipated_;
-  s.rank_drive_work = drive_work_;
+  s.rank_ledger = ledger_;
   s.baseline_taken = baseline_taken_;
   s.balance0 = balance0_;
   s.motion0 = motion0_;
@@ -193,7 +191,6 @@ RunState Simulation::run_state() const {
   s.neighbor_builds = neighbor_builds();
   s.guards = guards_;
   if (grinding_) s.grinding = grinding_->state();
-  s.rank_drum_work = drum_work_;
   s.mill_samples = mill_window_.samples();
   if (spectra_) {
     s.spectra_counts = spectra_->counts();
@@ -282,8 +279,9 @@ void Simulation::population_step() {
     grinding_->plan(time_, step_, particles_, contacts_, *domain_, /*evaluated=*/false);
   // The energy before the change, taken only in a step that changes the store (most do not).
   double before = 0.0;
-  const double fed = grinding_->fed_energy(), discharged = grinding_->discharged_energy();
-  if (!grinding_->apply(time_, particles_, contacts_, *domain_, [&] { before = local_energy(); }))
+  const double fed = ledger_.fed, discharged = ledger_.discharged;
+  if (!grinding_->apply(time_, particles_, contacts_, *domain_, ledger_,
+                        [&] { before = local_energy(); }))
     return;
   domain_->population_changed(domain_->sum(static_cast<std::int64_t>(particles_.n_owned())));
   rebuild();
@@ -293,8 +291,8 @@ void Simulation::population_step() {
   // Fragments keep the parents' mass and momentum and lose kinetic energy (their spin inertia
   // is smaller); the springs of the parents' and the product's contacts and of contacts
   // excluded at birth are gone: all of it is booked as dissipated, so the balance holds.
-  dissipated_ += before - local_energy() + (grinding_->fed_energy() - fed) -
-                 (grinding_->discharged_energy() - discharged);
+  ledger_.dissipated +=
+      before - local_energy() + (ledger_.fed - fed) - (ledger_.discharged - discharged);
   backup_.save(particles_, time_, step_);
   builds_at_backup_ = contacts_.builds();
 }
@@ -302,10 +300,7 @@ void Simulation::population_step() {
 double Simulation::local_energy() const {
   const ParticleStore& p = particles_;
   double e = contacts_.totals().elastic;
-  for (std::size_t k = 0; k < p.n_owned(); ++k)
-    e += 0.5 * p.mass[k] *
-             (norm2(p.vel[k]) + 0.4 * p.radius[k] * p.radius[k] * p.omega[k] * p.omega[k]) -
-         p.mass[k] * dot(scene_.run.gravity, p.pos[k]);
+  for (std::size_t k = 0; k < p.n_owned(); ++k) e += mechanical_energy(p, k, scene_.run.gravity);
   return e;
 }
 
@@ -411,12 +406,6 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
   contacts_.evaluate(particles_, walls_, dt);
 }
 
-void Simulation::book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega) {
-  dissipated_ += t.dissipated + late_loss;
-  drive_work_ += t.drive_power * dt;
-  drum_work_ += t.drum_torque * drum_omega * dt;
-}
-
 void Simulation::commit(double dt, double late_loss) {
   if (spectra_) {  // the spectra's tracker keeps the trial slots (Kernel::kInPlace)
     const PairList& pl = contacts_.pairs();
@@ -428,7 +417,7 @@ void Simulation::commit(double dt, double late_loss) {
                          contacts_.history_offset("peak_energy"));
   }
   contacts_.commit();
-  book(contacts_.totals(), dt, late_loss, walls_.drum_omega());
+  ledger_.book(contacts_.totals(), dt, late_loss, walls_.drum_omega());
 }
 
 void Simulation::refresh_forces() {
@@ -550,7 +539,7 @@ SeriesRow Simulation::diagnostics() const {
   double ke = 0.0, re = 0.0, pe = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     ke += 0.5 * p.mass[k] * norm2(p.vel[k]);
-    re += 0.5 * p.mass[k] * 0.4 * p.radius[k] * p.radius[k] * p.omega[k] * p.omega[k];
+    re += Disc::rotational_energy(p.mass[k], p.radius[k], p.omega[k]);
     pe -= p.mass[k] * dot(gravity, p.pos[k]);
   }
   const EvaluationTotals& totals = contacts_.totals();
@@ -560,15 +549,15 @@ SeriesRow Simulation::diagnostics() const {
   row.rotational_energy = domain_->sum(re);
   row.potential_energy = domain_->sum(pe);
   row.elastic_energy = domain_->sum(totals.elastic);
-  row.dissipated_energy = domain_->sum(dissipated_);
+  row.dissipated_energy = domain_->sum(ledger_.dissipated);
   row.drum_torque = domain_->sum(totals.drum_torque);
   row.drum_power = row.drum_torque * walls_.drum_omega();
-  row.drive_work = domain_->sum(drive_work_);
+  row.drive_work = domain_->sum(ledger_.drive_work);
   row.lifter_torque = domain_->sum(totals.lifter_torque);
   row.shell_torque = row.drum_torque - row.lifter_torque;
   row.shell_power = row.shell_torque * walls_.drum_omega();
   row.lifter_power = row.lifter_torque * walls_.drum_omega();
-  row.drum_work = domain_->sum(drum_work_);
+  row.drum_work = domain_->sum(ledger_.drum_work);
   row.passes = integrator_->passes().mean_since_row();
   if (grinding_) grinding_row(row);
   return row;
@@ -614,8 +603,8 @@ void Simulation::grinding_row(SeriesRow& row) const {
   }
   row.mill_mass = domain_->sum(mill);
   row.ore_mass = domain_->sum(ore_mass);
-  row.fed_energy = domain_->sum(grinding_->fed_energy());
-  row.discharged_energy = domain_->sum(grinding_->discharged_energy());
+  row.fed_energy = domain_->sum(ledger_.fed);
+  row.discharged_energy = domain_->sum(ledger_.discharged);
 }
 
 void Simulation::reset_pass_window() {

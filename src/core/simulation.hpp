@@ -25,6 +25,7 @@
 #include "core/contact_engine.hpp"
 #include "core/diagnostics.hpp"
 #include "core/domain.hpp"
+#include "core/energy_ledger.hpp"
 #include "core/grinding.hpp"
 #include "core/integrators.hpp"
 #include "core/materials.hpp"
@@ -166,8 +167,6 @@ class Simulation final : private StepStages {
   PairKinematics* drift_mirror() override { return contacts_.drift_mirror(particles_); }
   bool population_changes() override;
   void commit(double dt, double late_loss) override;
-  // The ledger's share of one step's totals.
-  void book(const EvaluationTotals& t, double dt, double late_loss, double drum_omega);
   // Whether step k may leave the store one drift ahead: its end is not observed, nor the run's
   // last, nor checked or backed up.
   bool may_run_ahead(std::int64_t k, bool end_observed) const;
@@ -217,10 +216,7 @@ class Simulation final : private StepStages {
 
   double time_ = 0.0;
   std::int64_t step_ = 0;
-  // Energy ledger: cumulative over the run (this rank's share).
-  double dissipated_ = 0.0;
-  double drive_work_ = 0.0;
-  double drum_work_ = 0.0;  // of the drum's drive alone
+  EnergyLedger ledger_;  // this rank's share, since the start
   MillWindow mill_window_;
   std::unique_ptr<CollisionSpectra> spectra_;
   // The energy balance at the start, and the energy then in motion and in the springs.

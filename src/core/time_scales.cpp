@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/disc.hpp"
 #include "core/materials.hpp"
 #include "core/walls.hpp"
 
@@ -111,14 +112,14 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
     ts.rayleigh =
         std::min(ts.rayleigh, std::numbers::pi * r_min[a] * std::sqrt(m.density / m.shear_modulus) /
                                   (0.1631 * m.poisson_ratio + 0.8766));
-    const double mass_a = ParticleStore::sphere_mass(r_min[a], m.density);
+    const double mass_a = Disc::mass(r_min[a], m.density);
     for (std::size_t b = 0; b < nm; ++b) {
       const double e_star = table(static_cast<int>(a), static_cast<int>(b)).e_star;
       // The smallest sphere against a wall of material b (m* = m, R* = r).
       ts.hertz = std::min(ts.hertz, contact_time(mass_a, r_min[a], e_star, v.wall));
       // Against the smallest sphere of material b: the pair's reduced mass and radius.
       if (r_min[b] == std::numeric_limits<double>::max()) continue;
-      const double mass_b = ParticleStore::sphere_mass(r_min[b], scene.materials[b].density);
+      const double mass_b = Disc::mass(r_min[b], scene.materials[b].density);
       ts.hertz = std::min(
           ts.hertz, contact_time(mass_a * mass_b / (mass_a + mass_b),
                                  r_min[a] * r_min[b] / (r_min[a] + r_min[b]), e_star, v.pair));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/contact_engine.hpp"
+#include "core/drum_geometry.hpp"
 #include "core/errors.hpp"
 #include "core/integrators.hpp"
 
@@ -38,11 +39,6 @@ std::string error_at(const Scene& scene, const std::string& key, const std::stri
   return where(scene, key) + ": error: " + key + message;
 }
 
-// The radius of the drum's inscribed circle (the polygon's apothem).
-double inner_radius(const DrumSpec& drum) {
-  return drum.sides == 0 ? drum.radius : drum.radius * std::cos(std::numbers::pi / drum.sides);
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -64,7 +60,7 @@ double fill_lattice_sites(const Scene& scene, std::size_t fill) {
   Vec2 extent = s.box_max - s.box_min;
   double kept = 1.0;  // the share of the bounding box's sites the region keeps
   if (s.region != FillRegion::kBox) {
-    const double d = 2.0 * inner_radius(scene.drum);
+    const double d = 2.0 * DrumGeometry(scene.drum).inner_radius();
     extent = {d, d};
     kept = std::numbers::pi / 4.0;
   }
@@ -158,33 +154,6 @@ void check_memory(const Scene& scene, double available) {
             "; use larger particles or a smaller region"));
   }
   if (!errors.empty()) throw InputError(errors);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Lifters
-
-std::optional<LifterOverlap> lifter_overlap(const DrumSpec& drum, Vec2 x, double r) {
-  if (!drum.present) return std::nullopt;
-  const Vec2 rel = x - drum.center;
-  const double distance = norm(rel);
-  const double inner = inner_radius(drum);
-  for (std::size_t l = 0; l < drum.lifters.size(); ++l) {
-    const LifterSpec& lifter = drum.lifters[l];
-    const double top = inner - lifter.height;  // the bar's face towards the axis
-    if (distance + r <= top) continue;         // nearer the axis than every bar of this set
-    for (int k = 0; k < lifter.count; ++k) {
-      const double phi = drum.angle + lifter.angle + 2.0 * std::numbers::pi * k / lifter.count;
-      const Vec2 radial{std::cos(phi), std::sin(phi)};
-      const double s = dot(rel, radial);        // along the bar, from the axis
-      const double t = dot(rel, perp(radial));  // across it
-      const double dx = std::max({top - s, s - drum.radius, 0.0});
-      const double dy = std::max(std::abs(t) - 0.5 * lifter.width, 0.0);
-      const bool inside = dx == 0.0 && dy == 0.0;
-      if (inside || dx * dx + dy * dy < r * r)
-        return LifterOverlap{l, k, inside, std::sqrt(dx * dx + dy * dy)};
-    }
-  }
-  return std::nullopt;
 }
 
 // ---------------------------------------------------------------------------------------------

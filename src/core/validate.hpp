@@ -7,7 +7,6 @@
 #pragma once
 
 #include <cstddef>
-#include <optional>
 #include <string>
 
 #include "core/particles.hpp"
@@ -55,23 +54,6 @@ double physical_memory_bytes();
 // fill's lattice would need more than `available` bytes; the message names the fill's count
 // (fill_fraction, radius) key, the estimate and the memory available.
 void check_memory(const Scene& scene, double available);
-
-// ---------------------------------------------------------------------------------------------
-// Lifters
-
-// A disc that reaches into a lifter bar at t = 0: which [[drum.lifter]] and which of its bars,
-// whether its centre lies inside the bar, and how far the centre is from the bar (0 inside).
-struct LifterOverlap {
-  std::size_t lifter = 0;
-  int bar = 0;
-  bool inside = false;
-  double distance = 0.0;  // m
-};
-
-// The first lifter bar that a disc at x of radius r overlaps (closer to the bar than r, or
-// inside it) with the drum at its initial angle, or nullopt. A bar is the rectangle of the
-// lifter's width that stands on the shell up to its height (core/walls.cpp).
-std::optional<LifterOverlap> lifter_overlap(const DrumSpec& drum, Vec2 x, double r);
 
 // ---------------------------------------------------------------------------------------------
 // The first step

@@ -5,6 +5,8 @@
 #include <numbers>
 #include <utility>
 
+#include "core/drum_geometry.hpp"
+
 namespace dem2d {
 
 double ramp_speed(double speed, double ramp, double t) {
@@ -29,6 +31,7 @@ Walls::Walls(const Scene& scene) {
     body.angle0 = d.angle;
     bodies_.push_back(body);
     const int mat = find_material(scene, d.material);
+    const DrumGeometry drum(d);
     if (d.sides == 0) {
       WallElement e;
       e.kind = WallKind::kCircle;
@@ -37,45 +40,29 @@ Walls::Walls(const Scene& scene) {
       e.radius = d.radius;
       elements_.push_back(e);
     } else {
-      // Regular N-gon with its vertices on the circle; vertex k at angle 2 pi k / N.
-      const double step = 2.0 * std::numbers::pi / d.sides;
       for (int k = 0; k < d.sides; ++k) {
         WallElement e;
         e.body = 0;
         e.material = mat;
-        e.a_ref = {d.radius * std::cos(k * step), d.radius * std::sin(k * step)};
-        e.b_ref = {d.radius * std::cos((k + 1) * step), d.radius * std::sin((k + 1) * step)};
+        e.a_ref = drum.vertex(k);
+        e.b_ref = drum.vertex(k + 1);
         elements_.push_back(e);
         rotating_reach_ = d.radius;
       }
     }
-    for (const LifterSpec& l : d.lifters) {
+    for (const DrumGeometry::Bar& bar : drum.bars()) {
+      const LifterSpec& l = d.lifters[bar.lifter];
       const int lmat = l.material.empty() ? mat : find_material(scene, l.material);
-      // A bar of width w standing on the shell, height h measured radially from the shell's
-      // inner surface (the circle, or the polygon's inscribed circle at the bar's foot).
-      const double inner =
-          d.sides == 0 ? d.radius : d.radius * std::cos(std::numbers::pi / d.sides);
-      for (int k = 0; k < l.count; ++k) {
-        const double phi = l.angle + 2.0 * std::numbers::pi * k / l.count;
-        const Vec2 radial{std::cos(phi), std::sin(phi)};
-        const Vec2 side = perp(radial);
-        // Feet reach slightly beyond the shell so no gap is left at the base.
-        const double foot = std::sqrt(d.radius * d.radius - 0.25 * l.width * l.width);
-        const Vec2 p0 = foot * radial - 0.5 * l.width * side;
-        const Vec2 p3 = foot * radial + 0.5 * l.width * side;
-        const Vec2 p1 = (inner - l.height) * radial - 0.5 * l.width * side;
-        const Vec2 p2 = (inner - l.height) * radial + 0.5 * l.width * side;
-        for (auto [a, b] : {std::pair{p0, p1}, std::pair{p1, p2}, std::pair{p2, p3}}) {
-          WallElement e;
-          e.part = WallPart::kLifter;
-          e.body = 0;
-          e.material = lmat;
-          e.a_ref = a;
-          e.b_ref = b;
-          elements_.push_back(e);
-        }
-        rotating_reach_ = d.radius;
+      for (std::size_t s = 0; s + 1 < bar.corner.size(); ++s) {
+        WallElement e;
+        e.part = WallPart::kLifter;
+        e.body = 0;
+        e.material = lmat;
+        e.a_ref = bar.corner[s];
+        e.b_ref = bar.corner[s + 1];
+        elements_.push_back(e);
       }
+      rotating_reach_ = d.radius;
     }
   }
   for (const WallSpec& w : scene.walls) {
@@ -119,22 +106,6 @@ void Walls::update(double time) {
     e.a = origin + rotate(e.a_ref, r);  // core/vec2.hpp: products never fused
     e.b = origin + rotate(e.b_ref, r);
   }
-}
-
-WallGeometry Walls::segment_geometry(const WallElement& e, Vec2 x, double r) {
-  WallGeometry g;
-  // Segment: closest point q on [a, b]; rounded ends.
-  const Vec2 ab = e.b - e.a;
-  const double len2 = norm2(ab);
-  double s = len2 > 0.0 ? dot(x - e.a, ab) / len2 : 0.0;
-  s = std::clamp(s, 0.0, 1.0);
-  const Vec2 q = e.a + s * ab;
-  const Vec2 d = q - x;
-  const double dist = norm(d);
-  g.n = dist > 0.0 ? (1.0 / dist) * d : perp(ab) * (1.0 / std::sqrt(len2));
-  g.delta = r - dist;
-  g.point = q;
-  return g;
 }
 
 std::vector<std::vector<Vec2>> wall_outlines(const Walls& walls, int circle_points) {

@@ -6,8 +6,9 @@
 // T 1.6), the three exposed sides of each rectangular lifter (seed 003), and straight segments.
 // Elements of the drum are stored in the drum frame and placed in the lab frame by `update`.
 //
-// Contact with a wall element (physics.md section 2): R* = r_i, m* = m_i, the wall's velocity
-// at the contact point p is u_body + Omega_body z x (p - c_body), w_rel = w_i - Omega_body.
+// The narrow phase of a particle against an element is its shape's (core/disc.hpp). In contact,
+// R* = r_i and m* = m_i, the wall's velocity at the contact point p is
+// u_body + Omega_body z x (p - c_body), and w_rel = w_i - Omega_body (docs/models.md).
 #pragma once
 
 #include <algorithm>
@@ -45,57 +46,12 @@ struct WallElement {
   Vec2 a{}, b{};          // segment ends in the lab frame at the current time
 };
 
-// Closest contact of a sphere (centre x, radius r) with one element at the current time.
-struct WallGeometry {
-  double delta = 0.0;  // overlap (> 0 in contact); for the reach test: r - distance to surface
-  Vec2 n{};            // unit normal from the sphere's centre towards the wall
-  Vec2 point{};        // contact point on the wall
-};
-
-// A sphere of radius r inside a circle of radius R, its centre at d from the circle's centre c
-// (d2 = |d|^2, dist = |d|). Walls and the force kernel's wall gather share these two, so that
-// both compute the same bits.
-// Clear of the circle (no contact): without the square root of the full geometry.
-[[gnu::always_inline]] inline bool clear_inside_circle(double R, double r, double d2) {
-  const double inner = R - r;
-  return inner > 0.0 && d2 <= inner * inner;
-}
-// delta = |d| + r - R, the normal from the sphere towards the shell, the point on the shell.
-[[gnu::always_inline]] inline WallGeometry circle_geometry(Vec2 c, double R, Vec2 d, double dist,
-                                                           double r) {
-  WallGeometry g;
-  g.n = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
-  g.delta = dist + r - R;
-  g.point = c + R * g.n;
-  return g;
-}
-
 class Walls {
  public:
   Walls() = default;
   Walls(const Scene& scene);  // materials resolved by name through `scene`
 
   void update(double time);  // body states and element lab positions at `time`
-  // Inline for the circle (the drum's shell: most wall contacts of a round mill), the segment
-  // out of line.
-  WallGeometry geometry(int element, Vec2 x, double r) const {
-    const WallElement& e = elements_[element];
-    if (e.kind != WallKind::kCircle) return segment_geometry(e, x, r);
-    const Vec2 c = circle_center(e);
-    const Vec2 d = x - c;
-    return circle_geometry(c, e.radius, d, norm(d), r);
-  }
-  // Whether a sphere at x of radius r overlaps the element (geometry(...).delta > 0) without
-  // the square root and division of the full geometry: the cheap test of the force kernel.
-  bool touches(int element, Vec2 x, double r) const {
-    const WallElement& e = elements_[element];
-    if (e.kind == WallKind::kCircle)
-      return !clear_inside_circle(e.radius, r, norm2(x - circle_center(e)));
-    const Vec2 ab = e.b - e.a;
-    const double len2 = norm2(ab);
-    const double s = len2 > 0.0 ? std::clamp(dot(x - e.a, ab) / len2, 0.0, 1.0) : 0.0;
-    return !(norm2(e.a + s * ab - x) >= r * r);
-  }
   // The centre of a circle element (its body's centre at the current time).
   Vec2 circle_center(const WallElement& e) const {
     return bodies_[e.body].center + bodies_[e.body].offset;
@@ -119,7 +75,6 @@ class Walls {
   double drum_speed() const { return has_drum() ? bodies_[drum_body_].speed : 0.0; }
 
  private:
-  static WallGeometry segment_geometry(const WallElement& e, Vec2 x, double r);
   std::vector<WallBody> bodies_;
   std::vector<WallElement> elements_;
   int drum_body_ = -1;

@@ -63,11 +63,11 @@ std::vector<std::pair<const char*, double*>> real_slots(RunState& s) {
 }
 // The per-rank shares (/ranks/NAME).
 std::vector<std::pair<const char*, double*>> share_slots(RunState& s) {
-  return {{"dissipated", &s.rank_dissipated},
-          {"drive_work", &s.rank_drive_work},
-          {"fed_energy", &s.grinding.rank_fed_energy},
-          {"discharged_energy", &s.grinding.rank_discharged_energy},
-          {"drum_work", &s.rank_drum_work}};
+  return {{"dissipated", &s.rank_ledger.dissipated},
+          {"drive_work", &s.rank_ledger.drive_work},
+          {"fed_energy", &s.rank_ledger.fed},
+          {"discharged_energy", &s.rank_ledger.discharged},
+          {"drum_work", &s.rank_ledger.drum_work}};
 }
 
 // The mill analytics (/analysis): the window's samples, 8 values each (every rank holds the

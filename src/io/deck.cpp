@@ -30,6 +30,7 @@
 #include <unordered_map>
 #include <utility>
 
+#include "core/drum_geometry.hpp"
 #include "core/errors.hpp"
 #include "core/validate.hpp"
 #include "io/deck_schema.hpp"
@@ -656,21 +657,6 @@ void require(const TableReader& r, const deck::Table<T>& spec, std::string_view 
 // ---------------------------------------------------------------------------------------------
 // Placement: where the deck's own particles start (docs/input.md, "Placement")
 
-// How far x lies inside the drum's shell: from the circle, or from the nearest side of the
-// polygon (its vertices on the radius, rotated by drum.angle); negative outside.
-double shell_clearance(const DrumSpec& d, Vec2 x) {
-  const Vec2 rel = x - d.center;
-  double clearance = d.radius - norm(rel);
-  if (d.sides < 3) return clearance;
-  const double apothem = d.radius * std::cos(std::numbers::pi / d.sides);
-  const double step = 2.0 * std::numbers::pi / d.sides;
-  for (int k = 0; k < d.sides; ++k) {
-    const double phi = d.angle + (k + 0.5) * step;  // the outward normal of side k
-    clearance = std::min(clearance, apothem - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
-  }
-  return clearance;
-}
-
 // The particles that one [[fill]] file added to Scene::particles, and the file as messages
 // name it.
 struct FileRows {
@@ -699,7 +685,7 @@ class Placement {
 
   Placement(const Scene& scene, Diagnostics& diag, const std::vector<const toml::table*>& tables,
             std::vector<FileRows> files)
-      : scene_(scene), diag_(diag), tables_(tables), files_(std::move(files)) {}
+      : scene_(scene), drum_(scene.drum), diag_(diag), tables_(tables), files_(std::move(files)) {}
 
   void check() {
     for (std::size_t i = 0; i < scene_.particles.size(); ++i) {
@@ -721,7 +707,7 @@ class Placement {
     const DrumSpec& d = scene_.drum;
     const ParticleSpec& p = scene_.particles[i];
     if (!d.present) return false;
-    const double clearance = shell_clearance(d, p.position);
+    const double clearance = drum_.shell_clearance(p.position);
     const double overlap = p.radius - clearance;
     if (overlap <= kPlacementOverlap * p.radius) return true;
     const std::string drum =
@@ -741,7 +727,7 @@ class Placement {
   void clear_of_lifters(std::size_t i) {
     const ParticleSpec& p = scene_.particles[i];
     const double reach = p.radius - kPlacementOverlap * p.radius;
-    const auto bar = lifter_overlap(scene_.drum, p.position, reach);
+    const auto bar = drum_.bar_overlap(p.position, reach);
     if (!bar) return;
     const std::string which = fmt::format(
         "bar {} of drum.lifter[{}] (the bars at the drum's initial angle)", bar->bar, bar->lifter);
@@ -838,6 +824,7 @@ class Placement {
   }
 
   const Scene& scene_;
+  DrumGeometry drum_;
   Diagnostics& diag_;
   const std::vector<const toml::table*>& tables_;
   std::vector<FileRows> files_;
@@ -1314,7 +1301,7 @@ class DeckParser {
   // lifter bars (else it would fall forever outside the drum, or start inside a bar).
   void check_feed_point(const TableReader& r, const FeedSpec& f) {
     const DrumSpec& d = scene_.drum;
-    const double clearance = shell_clearance(d, f.point);
+    const double clearance = DrumGeometry(d).shell_clearance(f.point);
     if (clearance < f.radius_max) {
       r.invalid("point",
                 fmt::format("a fed particle of radius_max {:g} m {} the drum (radius {:g} "
@@ -1323,7 +1310,7 @@ class DeckParser {
                             f.radius_max,
                             clearance <= -f.radius_max ? "lies outside" : "straddles the shell of",
                             d.radius, d.center.x, d.center.y));
-    } else if (const auto bar = lifter_overlap(d, f.point, f.radius_max)) {
+    } else if (const auto bar = DrumGeometry(d).bar_overlap(f.point, f.radius_max)) {
       r.invalid("point", fmt::format("a fed particle of radius_max {:g} m {} bar {} of "
                                      "drum.lifter[{}]; give a point clear of the lifters",
                                      f.radius_max, bar->inside ? "lies inside" : "overlaps",

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "core/contact_models.hpp"
+#include "core/disc.hpp"
 #include "core/errors.hpp"
 #include "core/fill.hpp"
 #include "core/materials.hpp"
@@ -59,7 +60,7 @@ void expect_valid_packing(const Scene& s, const ParticleStore& p, const Walls& w
     for (std::size_t b = a + 1; b < p.size(); ++b)
       ASSERT_GE(norm(p.pos[a] - p.pos[b]), p.radius[a] + p.radius[b]) << "ids " << a << ", " << b;
     for (int e = 0; e < static_cast<int>(walls.elements().size()); ++e)
-      ASSERT_LE(walls.geometry(e, p.pos[a], p.radius[a]).delta, 1e-12)
+      ASSERT_LE(Disc::wall(walls, e, p.pos[a], p.radius[a]).delta, 1e-12)
           << "id " << a << " wall " << e;
     if (s.drum.present) {
       ASSERT_LE(norm(p.pos[a] - s.drum.center) + p.radius[a], s.drum.radius + 1e-12);

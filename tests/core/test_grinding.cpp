@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "core/contact_models.hpp"
+#include "core/disc.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
 
@@ -114,13 +115,12 @@ TEST(Grinding, ABreakConservesMassAndMomentumAndCreatesNoEnergy) {
     for (std::size_t k = 0; k < f.n_owned(); ++k) {
       mass += f.mass[k];
       momentum += f.mass[k] * f.vel[k];
-      kinetic +=
-          0.5 * f.mass[k] * norm2(f.vel[k]) +
-          0.5 * ParticleStore::sphere_inertia(f.mass[k], f.radius[k]) * f.omega[k] * f.omega[k];
+      kinetic += 0.5 * f.mass[k] * norm2(f.vel[k]) +
+                 0.5 * Disc::inertia(f.mass[k], f.radius[k]) * f.omega[k] * f.omega[k];
     }
     const double parent_kinetic =
         0.5 * q.mass[0] * norm2(q.vel[0]) +
-        0.5 * ParticleStore::sphere_inertia(q.mass[0], q.radius[0]) * q.omega[0] * q.omega[0];
+        0.5 * Disc::inertia(q.mass[0], q.radius[0]) * q.omega[0] * q.omega[0];
     EXPECT_GE(f.n_owned(), 2u);
     EXPECT_NEAR(mass, q.mass[0], 1e-12 * q.mass[0]);
     EXPECT_NEAR(momentum.x, q.mass[0] * q.vel[0].x, 1e-12 * q.mass[0]);
@@ -383,7 +383,7 @@ TEST(Grinding, FeedByMassRateAtAPointKeepsUpAndWaitsForRoom) {
   s.feed.has_point = true;
   s.feed.point = {0.0, 1.5};
   Simulation sim(s);
-  const double m_particle = ParticleStore::sphere_mass(0.05, 4800.0);
+  const double m_particle = Disc::mass(0.05, 4800.0);
   std::int64_t seen = 0;
   while (sim.time() < 0.3) {
     sim.step();

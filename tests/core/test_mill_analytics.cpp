@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/disc.hpp"
 #include "core/mill_analytics.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
@@ -272,7 +273,7 @@ TEST(CollisionSpectra, ElasticImpactsBookTheirKineticEnergy) {
   Simulation sim(s);
   sim.run_until(0.6);
   const CollisionSpectra& spectra = *sim.spectra();
-  const double m = ParticleStore::sphere_mass(kBall, 7800.0);
+  const double m = Disc::mass(kBall, 7800.0);
   const auto booked = [&](ContactType t) {
     std::int64_t n = 0;
     for (int k = 0; k < spectra.size_classes(); ++k)

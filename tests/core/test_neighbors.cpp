@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/disc.hpp"
 #include "core/neighbors.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
@@ -30,7 +31,7 @@ std::vector<IdPair> brute_force_wall_pairs(const ParticleStore& p, const Walls& 
   std::vector<IdPair> out;
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     for (int e = 0; e < static_cast<int>(walls.elements().size()); ++e)
-      if (walls.geometry(e, p.pos[k], p.radius[k]).delta > -skin) out.emplace_back(p.id[k], e);
+      if (Disc::wall(walls, e, p.pos[k], p.radius[k]).delta > -skin) out.emplace_back(p.id[k], e);
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -367,8 +368,7 @@ TEST(Neighbors, ContactSetEqualsBruteForceDuringARun) {
     std::vector<IdPair> found_w;
     const WallPairList& wl = sim.wall_pairs();
     for (std::size_t k = 0; k < wl.size(); ++k)
-      if (sim.walls()
-              .geometry(wl.element[k], p.pos[wl.particle[k]], p.radius[wl.particle[k]])
+      if (Disc::wall(sim.walls(), wl.element[k], p.pos[wl.particle[k]], p.radius[wl.particle[k]])
               .delta > 0.0)
         found_w.emplace_back(wl.id[k], wl.element[k]);
     ASSERT_EQ(found_w, brute_force_wall_pairs(p, sim.walls(), 0.0)) << "step " << step;

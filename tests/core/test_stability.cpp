@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/disc.hpp"
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
@@ -126,7 +127,7 @@ TEST(Stability, AutoDtResolvesAHeadOnPairWithTheIntendedSteps) {
 // overlap of the elastic impact equals Hertz's (validation.md section 1):
 // delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) with v = 40 m/s.
 TEST(Stability, HeadOnSteelAt20MetresPerSecondAtAutoDt) {
-  const double m_eff = 0.5 * ParticleStore::sphere_mass(0.1, 7800.0);
+  const double m_eff = 0.5 * Disc::mass(0.1, 7800.0);
   const double e_star = 2.0e11 / (2.0 * (1.0 - 0.25 * 0.25));
   const double delta_max = std::pow(15.0 * m_eff * 1600.0 / (16.0 * e_star * std::sqrt(0.05)), 0.4);
   for (IntegratorKind integrator : {IntegratorKind::kVerlet, IntegratorKind::kIterative}) {
@@ -282,7 +283,7 @@ TEST(Stability, CentrifugeSceneRunsTenSeconds) {
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     for (int e = 0; e < static_cast<int>(sim.walls().elements().size()); ++e)
       worst_penetration = std::max(
-          worst_penetration, sim.walls().geometry(e, p.pos[k], p.radius[k]).delta / p.radius[k]);
+          worst_penetration, Disc::wall(sim.walls(), e, p.pos[k], p.radius[k]).delta / p.radius[k]);
     EXPECT_LT(norm(p.pos[k]), 2.5) << "inside the drum";
     l += p.mass[k] * cross(p.pos[k], p.vel[k]);
     inertia += p.mass[k] * norm2(p.pos[k]);

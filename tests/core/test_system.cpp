@@ -23,6 +23,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/disc.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
@@ -265,8 +266,8 @@ TEST(SystemRest, LoneBallOnShellStopsOnlyWithRollingResistance) {
   const double v_bottom =
       std::sqrt(10.0 / 7.0 * kG * 2.4 * (1.0 - std::cos(10.0 * std::numbers::pi / 180.0)));
   EXPECT_NEAR(none.peak_late, v_bottom, 0.02 * v_bottom);
-  EXPECT_LT(none.dissipated, 1e-3 * ParticleStore::sphere_mass(0.1, 7800.0) * 0.5 * v_bottom *
-                                 v_bottom / (5.0 / 7.0));
+  EXPECT_LT(none.dissipated,
+            1e-3 * Disc::mass(0.1, 7800.0) * 0.5 * v_bottom * v_bottom / (5.0 / 7.0));
   EXPECT_LT(constant.peak_late, 1e-4);
   EXPECT_LE(std::abs(constant.angle), std::atan(0.05) + 1e-3);
 }
@@ -392,7 +393,7 @@ TEST(SystemRegimes, CentrifugingAt10RadPerSecondTurnsWithTheDrum) {
       worst_slip = std::max(worst_slip, norm(p.vel[i] - omega * perp(d)) / (omega * 2.5));
       double gap = 1e9;
       for (int e = 0; e < static_cast<int>(sim.walls().elements().size()); ++e)
-        gap = std::min(gap, -sim.walls().geometry(e, p.pos[i], p.radius[i]).delta);
+        gap = std::min(gap, -Disc::wall(sim.walls(), e, p.pos[i], p.radius[i]).delta);
       deepest = std::max(deepest, gap);
     }
   }
@@ -504,7 +505,7 @@ TEST(SystemIntegrators, IterativeConvergesOnlyBelowSqrt6) {
     w.to = {1.0, 0.0};
     w.material = "steel";
     s.walls.push_back(w);
-    const double mass = ParticleStore::sphere_mass(0.1, 7800.0);
+    const double mass = Disc::mass(0.1, 7800.0);
     const double delta_eq = mass * kG / m.normal_stiffness;
     ParticleSpec b;
     b.material = "steel";

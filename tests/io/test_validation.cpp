@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/drum_geometry.hpp"
 #include "core/errors.hpp"
 #include "core/fill.hpp"
 #include "core/simulation.hpp"
@@ -346,7 +347,7 @@ region = "full"
   place_particles(s, walls, p);
   ASSERT_EQ(p.size(), 400u);
   for (std::size_t k = 0; k < p.size(); ++k)
-    EXPECT_FALSE(lifter_overlap(s.drum, p.pos[k], p.radius[k])) << "particle " << k;
+    EXPECT_FALSE(DrumGeometry(s.drum).bar_overlap(p.pos[k], p.radius[k])) << "particle " << k;
 }
 
 // The feed's point must hold a particle of radius_max inside the shell and clear of the bars.

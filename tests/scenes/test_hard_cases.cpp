@@ -10,6 +10,7 @@
 #include <iostream>
 #include <numbers>
 
+#include "core/disc.hpp"
 #include "core/simulation.hpp"
 #include "support/thesis.hpp"
 
@@ -84,7 +85,7 @@ TEST(HardCases, TenBallStackRestsAtTheHertzOverlap) {
   Simulation sim(s);
   sim.run_until(0.6);
   const ParticleStore& p = sim.particles();
-  const double m = ParticleStore::sphere_mass(r, 7800.0);
+  const double m = Disc::mass(r, 7800.0);
   const double e_star = 2.0e11 / (2.0 * (1.0 - 0.25 * 0.25));
   const double force = 10.0 * m * 9.81;
   const double delta = std::pow(3.0 * force / (4.0 * e_star * std::sqrt(r)), 2.0 / 3.0);
