@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string_view>
@@ -13,28 +14,73 @@
 
 namespace dem2d {
 
-std::string run_json_text(const Scene& scene, const RunInfo& info) {
-  std::string out = "{\n";
-  const auto member = [&](std::string_view key, std::string_view json) {
-    out += fmt::format("  {}: {},\n", quoted_string(key), json);
-  };
-  member("version", quoted_string(info.version));
-  member("ranks", fmt::format("{}", info.ranks));
-  member("wall_time_s", json_number(info.wall_time_s));
-  member("steps", fmt::format("{}", info.steps));
-  member("particle_steps_per_second", json_number(info.particle_steps_per_second));
-  member("dt", json_number(info.dt));
-  member("deck_path", quoted_string(scene.deck_path));
-  for (const auto& [key, json] : info.extra) member(key, json);
-  // The deck object, indented one level inside the outer one.
-  std::string deck = resolved_deck_json(scene);
-  std::string indented;
-  for (const char c : deck) {
-    indented += c;
-    if (c == '\n') indented += "  ";
+JsonObject& JsonObject::add(std::string_view key, std::string json) {
+  members_.emplace_back(quoted_string(key), std::move(json));
+  return *this;
+}
+
+JsonObject& JsonObject::add_string(std::string_view key, std::string_view text) {
+  return add(key, quoted_string(text));
+}
+
+JsonObject& JsonObject::add_integer(std::string_view key, std::int64_t x) {
+  return add(key, fmt::format("{}", x));
+}
+
+JsonObject& JsonObject::add_number(std::string_view key, double x) {
+  return add(key, json_number(x));
+}
+
+JsonObject& JsonObject::add_number(std::string_view key, double x, const char* format) {
+  return add(key, json_number(x, format));
+}
+
+JsonObject& JsonObject::add_members(const JsonObject& other) {
+  members_.insert(members_.end(), other.members_.begin(), other.members_.end());
+  return *this;
+}
+
+std::string JsonObject::inline_text() const {
+  std::string out = "{";
+  for (const auto& [key, json] : members_)
+    out += fmt::format("{}{}: {}", out.size() > 1 ? ", " : "", key, json);
+  return out + "}";
+}
+
+std::string JsonObject::block_text() const {
+  std::string out = "{";
+  for (const auto& [key, json] : members_) {
+    out += fmt::format("{}\n  {}: ", out.size() > 1 ? "," : "", key);
+    for (const char c : json) {
+      out += c;
+      if (c == '\n') out += "  ";
+    }
   }
-  out += fmt::format("  {}: {}\n}}\n", quoted_string("deck"), indented);
-  return out;
+  return out + "\n}";
+}
+
+std::string json_number(double x, const char* format) {
+  return std::isfinite(x) ? fmt_double(format, x) : "null";
+}
+
+std::string json_array(std::span<const double> values, const char* format) {
+  std::string out = "[";
+  for (const double v : values) out += (out.size() > 1 ? ", " : "") + json_number(v, format);
+  return out + "]";
+}
+
+std::string run_json_text(const Scene& scene, const RunInfo& info) {
+  JsonObject top;
+  top.add_string("version", info.version)
+      .add_integer("ranks", info.ranks)
+      .add_number("wall_time_s", info.wall_time_s)
+      .add_integer("steps", info.steps)
+      .add_number("particle_steps_per_second", info.particle_steps_per_second)
+      .add_number("dt", info.dt)
+      .add_string("deck_path", scene.deck_path)
+      .add_members(info.extra)
+      .add("deck", resolved_deck_json(scene));
+  return top.block_text() + "\n";
 }
 
 void write_run_json(const std::string& path, const Scene& scene, const RunInfo& info) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 namespace dem2d {
@@ -76,6 +77,12 @@ std::string toml_number(double v) {
 }
 
 std::string json_number(double v) { return std::isfinite(v) ? shortest_number(v) : "null"; }
+
+std::string fmt_double(const char* format, double x) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, format, x);
+  return buf;
+}
 
 std::string lowercase(std::string_view s) {
   std::string out(s);

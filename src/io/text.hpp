@@ -1,5 +1,5 @@
 // Small text utilities the io layer shares: TOML/JSON literals, "did you mean" suggestions,
-// lists for messages.
+// lists for messages, printf-formatted numbers.
 #pragma once
 
 #include <optional>
@@ -19,6 +19,10 @@ std::string quoted_string(std::string_view s);
 std::string toml_number(double v);
 // JSON: the same shortest text ("2", "1e-05"); null for inf and nan, which JSON lacks.
 std::string json_number(double v);
+
+// One double through a printf format ("%.4g s"), as snprintf writes it (at most 127
+// characters): the run's messages and reports.
+std::string fmt_double(const char* format, double x);
 
 std::string lowercase(std::string_view s);
 std::string_view trim(std::string_view s);  // spaces, tabs, CR, LF at both ends

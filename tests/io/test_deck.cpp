@@ -1415,7 +1415,7 @@ TEST(RunJson, HoldsTheRunAndTheResolvedDeck) {
   info.steps = 1000;
   info.particle_steps_per_second = 2.0e6;
   info.dt = 1.0e-5;
-  info.extra = {{"final_time", "0.01"}};
+  info.extra.add("final_time", "0.01");
   const fs::path path = dir.path() / "run.json";
   write_run_json(path.string(), scene, info);
   std::ifstream in(path);

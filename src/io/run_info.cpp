@@ -1,0 +1,100 @@
+#include "io/run_info.hpp"
+
+#include <algorithm>
+#include <numbers>
+
+#include "core/mill_analytics.hpp"
+#include "io/text.hpp"
+
+namespace dem2d {
+
+namespace {
+
+// Collective: run.json's "mill" object: the mill's numbers, and the averages and regime over
+// the last analysis window.
+JsonObject mill_json(const Simulation& sim, const MpiDomain& domain) {
+  const ParticleStore& p = sim.particles();
+  double area = 0.0, r_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    area += std::numbers::pi * p.radius[k] * p.radius[k];
+    r_max = std::max(r_max, p.radius[k]);
+  }
+  const MillNumbers m = mill_numbers(sim.scene(), domain.sum(area), domain.max(r_max));
+  const WindowSummary w = sim.mill_summary();
+  const std::pair<const char*, double> items[] = {
+      {"critical_speed_rad_s", m.critical_speed},
+      {"critical_speed_rpm", m.critical_speed * 30.0 / std::numbers::pi},
+      {"critical_speed_with_fill_rad_s", m.critical_speed_with_fill},
+      {"speed_fraction_of_critical", m.speed_fraction},
+      {"froude_number", m.froude},
+      {"fill_fraction", m.fill_fraction},
+      {"bed_filling", m.bed_filling},
+      {"bed_packing", kBedPacking},
+      {"slice_thickness_m", m.slice_thickness},
+      {"window_s", w.span},
+      {"power_avg_W", w.power},
+      {"power_per_metre_W", m.slice_thickness > 0 ? w.power / m.slice_thickness : 0.0},
+      {"airborne_fraction", w.airborne},
+      {"corotating_fraction", w.corotating},
+      {"toe_angle_deg", w.toe},
+      {"shoulder_angle_deg", w.shoulder},
+      {"surface_angle_deg", w.surface_angle},
+      {"charge_angle_deg", w.charge_angle},
+      {"charge_angle_std_deg", w.charge_angle_std}};
+  JsonObject mill;
+  mill.add_string("regime", regime_name(w.regime));
+  for (const auto& [key, value] : items) mill.add_number(key, value, "%.10g");
+  return mill;
+}
+
+// The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
+// ghosts, migrations and time in communication; the imbalance against equal angles.
+void add_decomposition(JsonObject& extra, const MpiDomain& domain) {
+  const DecompositionStats& ds = domain.stats();
+  const RankStats per_rank = domain.gather_rank_stats();
+  extra.add("rank_work", json_array(per_rank.work, "%.0f"))
+      .add("rank_ghosts", json_array(per_rank.ghosts, "%.0f"))
+      .add("rank_comm_seconds", json_array(per_rank.comm_seconds, "%.4g"))
+      .add_number("imbalance", ds.imbalance_work, "%.4g")
+      .add_number("imbalance_mean", ds.imbalance_mean(), "%.4g")
+      .add_number("imbalance_equal_angle", ds.imbalance_equal_angle, "%.4g")
+      .add_integer("partitions", ds.partitions)
+      .add_string("partition_method", ds.method)
+      .add_integer("sectors", domain.partition().n_sectors);
+}
+
+}  // namespace
+
+RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
+                 const RunFacts& facts) {
+  RunInfo info;
+  info.version = DEM2D_VERSION;
+  info.ranks = domain.size();
+  info.wall_time_s = facts.wall;
+  info.steps = sim.step_count();
+  info.particle_steps_per_second =
+      facts.wall > 0
+          ? static_cast<double>(facts.n_global) * static_cast<double>(facts.steps_here) / facts.wall
+          : 0.0;
+  info.dt = sim.dt();
+  JsonObject& extra = info.extra;
+  extra.add_integer("neighbor_builds", sim.neighbor_builds());
+  if (scene.run.integrator == IntegratorKind::kIterative) {
+    extra.add_number("mean_passes",
+                     static_cast<double>(sim.passes_total()) /
+                         static_cast<double>(std::max<std::int64_t>(1, sim.step_count())),
+                     "%.6g");
+    extra.add_integer("unconverged_steps", sim.unconverged_steps());
+  }
+  JsonObject guards;
+  for (const GuardRecord& g : sim.guard_records()) guards.add_integer(g.kind, g.count);
+  extra.add("guards_fired", guards.inline_text());
+  add_decomposition(extra, domain);
+  if (scene.drum.present) extra.add("mill", mill_json(sim, domain).inline_text());
+  extra.add("interrupted", facts.interrupted ? "true" : "false");
+  extra.add("restarted_from",
+            facts.restarted_from.empty() ? "null" : quoted_string(facts.restarted_from));
+  return info;
+}
+
+}  // namespace dem2d

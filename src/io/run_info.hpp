@@ -1,0 +1,27 @@
+// What run.json records of a finished run (io/run_json.hpp): timing, the neighbour builds, the
+// iterative integrator's passes, the guards, the decomposition's per-rank figures and, for a
+// mill, its numbers and the last analysis window's averages and regime.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "core/simulation.hpp"
+#include "io/run_json.hpp"
+#include "parallel/mpi_domain.hpp"
+
+namespace dem2d {
+
+struct RunFacts {
+  std::int64_t n_global = 0;    // particles over every rank
+  double wall = 0.0;            // s of wall time of the run loop
+  std::int64_t steps_here = 0;  // the steps this process took (a restart continues the count)
+  bool interrupted = false;     // stopped by SIGINT or SIGTERM
+  std::string restarted_from;   // the checkpoint continued (--restart), empty for a new run
+};
+
+// Collective (the decomposition's per-rank figures and the mill's totals are gathered).
+RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
+                 const RunFacts& facts);
+
+}  // namespace dem2d

@@ -1,0 +1,38 @@
+// The files a run appends to as it goes, seen from every rank: series.csv, and product.csv with
+// breakages.csv of ore scenes. Rank 0 alone writes; every write is agreed on, so a failure
+// there (disk full) stops every rank with the same message (IoError, exit 4) instead of leaving
+// the others in a collective.
+#pragma once
+
+#include <memory>
+
+#include "core/simulation.hpp"
+#include "io/ore_logs.hpp"
+#include "io/series.hpp"
+
+namespace dem2d {
+
+// series.csv.
+class SeriesOutput {
+ public:
+  // Collective. `resumed`: a restart, which continues the file after the checkpoint's step.
+  SeriesOutput(const Scene& scene, const Simulation& sim, bool resumed);
+  void write(const SeriesRow& row);  // collective
+
+ private:
+  std::unique_ptr<SeriesWriter> file_;
+};
+
+// product.csv and breakages.csv of ore scenes (nothing for other scenes): every rank's records
+// since the last write are gathered (parallel/ore_records.hpp) and rank 0 appends them.
+class OreOutput {
+ public:
+  // Collective. `resumed`: a restart, which keeps the rows up to the checkpoint's time.
+  OreOutput(const Scene& scene, const Simulation& sim, bool resumed);
+  void write(Simulation& sim);  // collective: takes the simulation's records
+
+ private:
+  std::unique_ptr<OreLogs> logs_;
+};
+
+}  // namespace dem2d
