@@ -1,5 +1,5 @@
 // memory_bandwidth: what one core can stream from and to memory, the ceiling to compare a step's
-// traffic with (docs/performance.md, "Seventh session").
+// traffic with (docs/performance.md, "Where the time goes").
 //
 //   build/bench/memory_bandwidth [--mb M] [--repeats R] [--results DIR]
 //   taskset -c 0 build/bench/memory_bandwidth          (one core, as bench/throughput is timed)

@@ -1,6 +1,6 @@
-// work_precision: speed against error of the two integrators (physics.md section 4).
+// work_precision: speed against error of the two integrators (docs/models.md, "Time integration").
 //
-// (a) Binary Hertz impact (validation.md section 1): two thesis steel balls (r = 0.1 m,
+// (a) Binary Hertz impact (docs/validation.md, "Hertz impact"): two thesis steel balls (r = 0.1 m,
 //     E = 2e11 Pa, G = 8e10 Pa, rho = 7800) meet head-on at 2 x 5 m/s without gravity or
 //     friction effects. With restitution 1 the contact time and the peak overlap are compared
 //     with Hertz's closed form; with restitution 0.73 (the thesis steel) the restitution
@@ -127,7 +127,7 @@ struct Hertz {
   double delta_max, t_c, e_star, r_eff, m_eff;
 };
 
-// validation.md section 1: delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) and
+// docs/validation.md, "Hertz impact": delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) and
 // t_c = 2 int_0^1 (1 - x^(5/2))^(-1/2) dx delta_max / v = (4/5) B(2/5, 1/2) delta_max / v
 //     = 2.94328 delta_max / v.
 Hertz hertz_closed_form() {

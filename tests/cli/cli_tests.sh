@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Command-line contract (interface.md): exit codes and messages for good and bad input, on one
-# and on two ranks. Usage: cli_tests.sh PATH/TO/dem2d SOURCE_DIR
+# Command-line contract (docs/architecture.md, "Command line and exit status"; README, "Using
+# dem2d"): exit codes and messages for good and bad input, on one and on two ranks.
+# Usage: cli_tests.sh PATH/TO/dem2d SOURCE_DIR
 # The cases run as a few background jobs at once (DEM2D_TEST_JOBS, 3 by default; tests/cli/lib.sh):
 # cases that share an output folder or read another case's output are one job, in order. The log
 # gives each job's cases in the order the jobs start.

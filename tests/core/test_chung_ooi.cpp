@@ -1,11 +1,12 @@
 // Chung & Ooi (2011), Granular Matter 13:643-656: the eight single-contact benchmarks, with the
-// reference numbers of validation.md section 2: (A) from the closed-form Hertz / rigid-body
-// formulas, (R) the reference curves as digitised in public DEM test suites (Kratos
-// DEMApplication tests/DEM3D_chung_ooi_tests, LIGGGHTS-PFM examples .../contact_models/chung).
-// Contact model hertz-mindlin, rolling none, no gravity; a rigid plane is a [[wall]] segment of a
-// material with E = 1e30 (then E* = E/(1-nu^2) of the sphere). Hertz-Mindlin "no-slip" with its
-// tangential spring gives the rigid-body gross-sliding answers only in the sliding regime, so the
-// tangential tests use the rigid-body formulas only where validation.md says they hold.
+// reference numbers of docs/validation.md, "Chung & Ooi (2011): set-ups and reference values": (A)
+// from the closed-form Hertz / rigid-body formulas, (R) the reference curves as digitised in public
+// DEM test suites (Kratos DEMApplication tests/DEM3D_chung_ooi_tests, LIGGGHTS-PFM examples
+// .../contact_models/chung). Contact model hertz-mindlin, rolling none, no gravity; a rigid plane
+// is a [[wall]] segment of a material with E = 1e30 (then E* = E/(1-nu^2) of the sphere).
+// Hertz-Mindlin "no-slip" with its tangential spring gives the rigid-body gross-sliding answers
+// only in the sliding regime, so the tangential tests use the rigid-body formulas only where
+// docs/validation.md says they hold.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -27,7 +28,7 @@ struct Material {
   const char* name;
   double young, nu, density;
 };
-// validation.md section 2, table of the eight tests.
+// docs/validation.md, "Chung & Ooi (2011): set-ups and reference values", table of the tests.
 constexpr Material kGlass{"glass", 48e9, 0.20, 2800};
 constexpr Material kLimestone{"limestone", 20e9, 0.25, 2500};
 constexpr Material kAlAlloyT2{"al_alloy", 70e9, 0.30, 2699};  // test 2
@@ -66,7 +67,7 @@ MaterialSpec rigid(const MaterialSpec& ball) {
 double e_star_of(const Material& m) { return m.young / (1.0 - m.nu * m.nu); }
 double mass_of(const Material& m, double r) { return 4.0 / 3.0 * kPi * r * r * r * m.density; }
 
-// Hertz contact time (validation.md section 1): t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5).
+// Hertz contact time (docs/validation.md, "Hertz impact"): t_c = 2.868 (m*^2 / (R* E*^2 v))^(1/5).
 double hertz_time(double m_eff, double r_eff, double e_star, double v) {
   return 2.868 * std::pow(m_eff * m_eff / (r_eff * e_star * e_star * v), 0.2);
 }
@@ -148,7 +149,7 @@ void expect_rel(double value, double reference, double tol, const std::string& w
 }
 
 // ---------------------------------------------------------------------------------------------
-// Test 1: two equal spheres, R = 10 mm, head-on at +-10 m/s, e = 1 (validation.md table (A)).
+// Test 1: two equal spheres, R = 10 mm, head-on at +-10 m/s, e = 1 (docs/validation.md, (A)).
 
 void run_test1(const Material& m, double delta_max, double f_max, double t_c) {
   const double r = 0.01;
@@ -174,7 +175,7 @@ TEST(ChungOoi, Test1LimestoneSpheresHeadOnMatchHertzPeakOverlapForceAndDuration)
 }
 
 // ---------------------------------------------------------------------------------------------
-// Test 2: sphere R = 0.1 m on a rigid plane at 0.2 m/s, e = 1 (validation.md table (A)).
+// Test 2: sphere R = 0.1 m on a rigid plane at 0.2 m/s, e = 1 (docs/validation.md, (A)).
 
 void run_test2(const Material& m, double delta_max, double f_max, double t_c) {
   const MaterialSpec ms = spec(m, 1.0, 0.0);
@@ -197,7 +198,7 @@ TEST(ChungOoi, Test2MagnesiumAlloySphereOnRigidPlaneMatchesHertz) {
 // ---------------------------------------------------------------------------------------------
 // Test 3: normal impact on a rigid plane at 3.9 m/s, R = 2.5 mm, e asked = 0.2 .. 1: the
 // restitution obtained must be the one asked (public suites: within 1e-3; issue: within 1 %).
-// At e = 1 the peak overlap, force and duration match validation.md's table (A).
+// At e = 1 the peak overlap, force and duration match docs/validation.md's (A) table.
 
 double test3_restitution(const Material& m, double e, double dt) {
   Simulation sim(sphere_on_plane(spec(m, e, 0.0), 0.0025, {0.0, -3.9}, 0.0, dt));
@@ -258,7 +259,7 @@ Rebound test4_formula(double incidence_deg) {
 }
 
 TEST(ChungOoi, Test4AluminiumOxideObliqueImpactMatchesReferenceCurvesInSlidingRegime) {
-  // (R) validation.md: 40 deg: e_t 0.781, w' -544.8 rad/s, t_r 11.57 deg; 60: 0.893, -357.5,
+  // (R) docs/validation.md: 40 deg: e_t 0.781, w' -544.8 rad/s, t_r 11.57 deg; 60: 0.893, -357.5,
   // 47.79; 80: 0.966, -126.3, 78.70. Within 2 %, except w' at 80 deg: the digitised -126.3 is
   // itself 2.4 % from the exact gross-sliding value -123.36 (formula above; Kratos's own DEM run
   // of this test gives -122.8), so that one point is held to 3 %; the next test checks the

@@ -1,11 +1,11 @@
-// Pair-level checks of the contact laws in closed form (physics.md sections 2-3), first by
+// Pair-level checks of the contact laws in closed form (docs/models.md, "Contact laws"), first by
 // calling the law structs of core/contact_models.hpp directly, then through a small Simulation
 // (force assembly, torques, signs): the thesis's ~20 direction tests (T section 1.9) for two
 // balls, a ball and a floor, a translating wall and a rotating drum.
 //
-// Conventions (physics.md section 1-2): x right, y up, every angle and spin counter-clockwise
-// positive; for a pair i < j, n points from i to j, t = perp(n) = (-n_y, n_x),
-// v_rel = (v_i - v_j) + (w_i r_i + w_j r_j) t, force on i = -F_n n + F_t t, torques
+// Conventions (docs/models.md, "Bodies and frame", "Contact kinematics"): x right, y up, every
+// angle and spin counter-clockwise positive; for a pair i < j, n points from i to j, t = perp(n) =
+// (-n_y, n_x), v_rel = (v_i - v_j) + (w_i r_i + w_j r_j) t, force on i = -F_n n + F_t t, torques
 // tau_i = r_i F_t, tau_j = r_j F_t (thesis model: R* F_t on both); a wall contact has n from the
 // sphere's centre towards the wall.
 #include <gtest/gtest.h>
@@ -145,7 +145,7 @@ double hertz_force(const PairCoeffs& c, double r_eff, double delta) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Effective coefficients (physics.md section 2).
+// Effective coefficients (docs/models.md, "Effective material values").
 
 TEST(PairTable, EffectiveModuliFollowPhysicsMdAndCoefficientsAreMeans) {
   Scene s;
@@ -177,7 +177,7 @@ TEST(PairTable, RigidWallGivesSphereModulusAlone) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Hertz-Mindlin normal force (physics.md section 3; Johnson 1985 section 4.2).
+// Hertz-Mindlin normal force (docs/models.md, "Contact laws"; Johnson 1985 section 4.2).
 
 TEST(HertzMindlinLaw, ElasticForceIsFourThirdsEstarSqrtRstarDeltaToOneAndAHalf) {
   const PairCoeffs c = steel_pair(1.0, 0.3);
@@ -368,7 +368,7 @@ TEST(ThesisLaw, TangentialForceIsCoulombOpposingSlipPlusViscous) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Rolling resistance (physics.md section 3; Ai et al. 2011 models A and C).
+// Rolling resistance (docs/models.md, "Rolling resistance"; Ai et al. 2011 models A and C).
 
 TEST(RollingLaw, NoneGivesNoTorque) {
   const PairCoeffs c = steel_pair(1.0, 0.3, 0.1);

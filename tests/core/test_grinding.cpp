@@ -1,5 +1,5 @@
-// Grinding (physics.md section 5, thesis T34-T36): the breakage law's statistics, the fragment
-// law, conservation at a break, the sieve and the feed.
+// Grinding (docs/models.md, "Grinding: breakage, feed, sieve"; thesis T34-T36): the breakage
+// law's statistics, the fragment law, conservation at a break, the sieve and the feed.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,5 @@
-// Restitution map of the clamped Hertz and linear laws (validation.md section 3).
+// Restitution map of the clamped Hertz and linear laws (docs/validation.md, "Restitution with a
+// clamped normal force").
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,8 +15,9 @@ double unclamped_beta(double e) {
   return l / std::sqrt(l * l + std::numbers::pi * std::numbers::pi);
 }
 
-// validation.md section 3: restitution obtained with the unclamped damping law once the force
-// is clamped at zero (Antypov & Elliott 2011; Thornton, Cummins & Cleary 2013).
+// docs/validation.md, "Restitution with a clamped normal force": restitution obtained with the
+// unclamped damping law once the force is clamped at zero (Antypov & Elliott 2011; Thornton,
+// Cummins & Cleary 2013).
 TEST(Restitution, ClampedHertzWithUnclampedBetaMatchesPublishedTable) {
   const double asked[] = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.98};
   const double obtained[] = {0.2527, 0.3249, 0.3971, 0.4720, 0.5503,

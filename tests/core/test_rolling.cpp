@@ -1,5 +1,6 @@
-// Rolling and sliding of a single sphere on a wall, with gravity (validation.md section 4):
-// the spinning ball set on a floor (thesis section 1.9, fig. 13), a sphere on an incline with
+// Rolling and sliding of a single sphere on a wall, with gravity (docs/validation.md, "Rolling
+// and sliding (Ai et al. 2011)"): the spinning ball set on a floor (thesis section 1.9, fig. 13),
+// a sphere on an incline with
 // rolling resistance (Ai, Chen, Rotter & Ooi 2011, Powder Technol. 206:269, models A = constant
 // and C = epsd), and Ai et al.'s sphere launched on a flat.
 // Sphere: thesis Table 1 steel (E = 2e11 Pa, G = 8e10 Pa -> nu = 0.25, rho = 7800), r = 0.1 m;
@@ -88,8 +89,9 @@ double rolling_acceleration(double t, double mu_r) {
 // ---------------------------------------------------------------------------------------------
 
 TEST(Rolling, SpinningBallSetOnFloorRollsOffAtTwoSeventhsOmegaR_ThesisFig13) {
-  // Thesis section 1.9 / validation.md section 4: angular momentum about the contact point is
-  // conserved, so v = -2/7 w0 r (a clockwise spin rolls to the right) and then w = -v/r.
+  // Thesis section 1.9 / docs/validation.md, "Rolling and sliding": angular momentum about the
+  // contact point is conserved, so v = -2/7 w0 r (a clockwise spin rolls to the right) and then
+  // w = -v/r.
   const double w0 = -20.0, mu_s = 0.3;
   Incline t(0.0, mu_s, 0.0, RollingModelKind::kNone, 0.0, w0);
   Simulation sim(t.scene);
@@ -103,7 +105,8 @@ TEST(Rolling, SpinningBallSetOnFloorRollsOffAtTwoSeventhsOmegaR_ThesisFig13) {
 }
 
 TEST(Rolling, SlidingBallSetOnFloorRollsOnAtFiveSeventhsV0_AiEtAl2011) {
-  // validation.md section 4: with mu_r = 0 a sphere launched without spin rolls on at 5/7 v0.
+  // docs/validation.md, "Rolling and sliding": with mu_r = 0 a sphere launched without spin
+  // rolls on at 5/7 v0.
   const double v0 = 1.0;
   Incline t(0.0, 0.3, 0.0, RollingModelKind::kNone, v0, 0.0);
   Simulation sim(t.scene);
@@ -213,9 +216,9 @@ TEST(Rolling, ConstantModelSphereOnInclineFlatterThanMuRDoesNotRollAway_AiEtAl20
   EXPECT_LT(std::abs(inc.speed(sim)), 1e-3);
 }
 
-// Ai et al. 2011 (validation.md section 4): sphere launched on a flat at v0 = 1 m/s without
-// spin, mu_s = 0.8: it slides while the friction spins it up, then rolls and decelerates under
-// the rolling resistance until it stops.
+// Ai et al. 2011 (docs/validation.md, "Rolling and sliding"): sphere launched on a flat at
+// v0 = 1 m/s without spin, mu_s = 0.8: it slides while the friction spins it up, then rolls and
+// decelerates under the rolling resistance until it stops.
 struct Launch {
   double slip_end = -1.0, slip_end_speed = 0.0, stop = -1.0, distance = 0.0;
 };

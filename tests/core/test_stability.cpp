@@ -1,7 +1,7 @@
-// Hard cases for the time step and the blow-up detection (physics.md section 4, interface.md
-// exit status 3): fast steel impacts at the auto dt, a size ratio of 10, particles touching the
-// walls at the start, the centrifuge scene, unsafe time steps refused or caught, and the largest
-// time step each integrator survives in the thesis's waterfall scene.
+// Hard cases for the time step and the blow-up detection (docs/models.md, "The time step,
+// stability and guards"; exit status 3): fast steel impacts at the auto dt, a size ratio of 10,
+// particles touching the walls at the start, the centrifuge scene, unsafe time steps refused or
+// caught, and the largest time step each integrator survives in the thesis's waterfall scene.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -124,7 +124,7 @@ TEST(Stability, AutoDtResolvesAHeadOnPairWithTheIntendedSteps) {
 }
 
 // Thesis restitution (zeta_n = 0.1 -> e = 0.73) and e = 1: obtained within 1 %, and the largest
-// overlap of the elastic impact equals Hertz's (validation.md section 1):
+// overlap of the elastic impact equals Hertz's (docs/validation.md, "Hertz impact"):
 // delta_max = (15 m* v^2 / (16 E* sqrt(R*)))^(2/5) with v = 40 m/s.
 TEST(Stability, HeadOnSteelAt20MetresPerSecondAtAutoDt) {
   const double m_eff = 0.5 * Disc::mass(0.1, 7800.0);
@@ -144,8 +144,8 @@ TEST(Stability, HeadOnSteelAt20MetresPerSecondAtAutoDt) {
   }
 }
 
-// physics.md section 3: the restitution asked must be obtained within 1 % for 0.1 <= e <= 1.
-// At the auto dt (0.2 Rayleigh time = 2.14e-5 s) the 40 m/s steel contact lasts ~14 steps
+// The restitution asked must be obtained within 1 % for 0.1 <= e <= 1 (docs/models.md, "Why
+// N(e)"). At the auto dt (0.2 Rayleigh time = 2.14e-5 s) the 40 m/s steel contact lasts ~14 steps
 // (t_c = 2.96e-4 s); Verlet's dashpot sees the half-step velocity (an O(dt) error) and the Hertz
 // dashpot grows as delta^(1/4) from the first touch, so strongly damped impacts miss.
 // Measured (Verlet / iterative, relative error): e = 0.1: -15 % / +3 %; 0.3: -3.9 % / +1.6 %;
@@ -504,9 +504,9 @@ TEST(Stability, UnsettledIterativePassesAreAnError) {
 }
 
 // Non-finite blow-up: two balls given the same centre (their contact normal is 0/0) among
-// others in a drum. interface.md (exit 3): "non-finite values, or an overlap beyond a safe
-// fraction of a radius: report step, time, particle ids, and the dt that would be safe". The
-// last finite state is restored.
+// others in a drum. Exit status 3 (docs/architecture.md, "Command line and exit status"): the
+// message names the step, the time, the particle ids and the safe dt. The last finite state is
+// restored.
 TEST(Stability, NonFiniteBlowUpNamesParticlesAndRestoresTheLastFiniteState) {
   Scene s = drum_scene(20, 0.0, 0);
   add_ball(s, {0.5, 0.5}, {}, 0.1);

@@ -1,10 +1,12 @@
 // System tests of the serial engine: energy bookkeeping, coming to rest, the thesis's drum
 // regimes, the two integrators against each other, and the steady-state drum identities
-// (physics.md sections 3, 4, 6; validation.md section 5).
+// (docs/models.md, "Contact laws", "Time integration" and "The thesis's parameters and scenes";
+// docs/validation.md, "Reference formulas", "Drums").
 //
-// "Thesis steel" below is Table 1 (physics.md section 6): E = 2e11 Pa, G = 8e10 Pa (nu = 0.25),
-// rho = 7800 kg/m^3, mu_s = 0.1, mu_r = 0.05 (epsd), ball radius 0.1 m, drum radius 2.5 m, with
-// restitution 0.73 (the thesis's zeta_n = 0.1 through T22, as in inputs/*.in).
+// "Thesis steel" below is Table 1 (docs/models.md, "The thesis's parameters and scenes"):
+// E = 2e11 Pa, G = 8e10 Pa (nu = 0.25), rho = 7800 kg/m^3, mu_s = 0.1, mu_r = 0.05 (epsd), ball
+// radius 0.1 m, drum radius 2.5 m, with restitution 0.73 (the thesis's zeta_n = 0.1 through T22,
+// as in inputs/*.in).
 //
 // Free flight. A ball is airborne while it feels no contact force at all (every step checked:
 // its acceleration is exactly g and its angular acceleration exactly 0). Dense steel beds make
@@ -273,9 +275,9 @@ TEST(SystemRest, LoneBallOnShellStopsOnlyWithRollingResistance) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// (d) The thesis regimes on a polygonal shell (physics.md section 6: a smooth circle with
-// mu = 0.1 lets the charge slide as a block and rock, period ~3 s, at 0.2, 1.8 and 10 rad/s
-// alike). Scan (thesis steel, ramp 0.5 s, dt 1e-5):
+// (d) The thesis regimes on a polygonal shell (docs/models.md, "The thesis's parameters and
+// scenes": a smooth circle with mu = 0.1 lets the charge slide as a block and rock, period ~3 s,
+// at 0.2, 1.8 and 10 rad/s alike). Scan (thesis steel, ramp 0.5 s, dt 1e-5):
 //   0.2 rad/s, 120 balls: with 8 to 24 sides the bed is carried up with the shell (charge
 //     omega = Omega for ~1.5 s), then slumps back and rocks with decaying swings; no ball flies
 //     (longest contact-free interval over 1-4 s: 0.113 s with 8 sides, 0.093 s with 16, 0.088 s
@@ -483,10 +485,10 @@ TEST(SystemIntegrators, IterativePassCountAtThesisDt) {
   EXPECT_LT(unconverged, 1e-3);
 }
 
-// The fixed-point passes converge only while omega_contact dt < sqrt(6) (physics.md section 4):
-// one ball resting on a floor on a linear spring (k = 1e7 N/m, no damping, no friction),
-// released 50 % above its equilibrium overlap so that it never leaves contact. Contraction
-// factor per pass: (omega dt)^2 / 6.
+// The fixed-point passes converge only while omega_contact dt < sqrt(6) (docs/models.md,
+// "Time integration"): one ball resting on a floor on a linear spring (k = 1e7 N/m, no damping,
+// no friction), released 50 % above its equilibrium overlap so that it never leaves contact.
+// Contraction factor per pass: (omega dt)^2 / 6.
 TEST(SystemIntegrators, IterativeConvergesOnlyBelowSqrt6) {
   auto run = [](double omega_dt, int* passes, std::int64_t* unconverged, bool* threw,
                 bool* finite) {
@@ -553,7 +555,7 @@ TEST(SystemIntegrators, IterativeConvergesOnlyBelowSqrt6) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// (g) Steady state of a rotating drum (validation.md section 5): the time-averaged drive torque
+// (g) Steady state of a rotating drum (docs/validation.md, "Drums"): the time-averaged drive torque
 // equals M g <x_cm>, and the drive power averages to the dissipation rate. 240 balls, 8-gon at
 // 1.8 rad/s (the 8-gon's cataract is the steadiest of the polygons scanned; the 16-gon's charge
 // surges with a ~3 s period, so a 3.5 s window is not a steady average there), averaged over

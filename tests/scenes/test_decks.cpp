@@ -157,7 +157,7 @@ TEST(Decks, LiftersLiftTheChargeThatASmoothShellLetsSlip) {
     sim.run_until(1.5);
     double angle = 0.0;
     int samples = 0;
-    while (sim.time() < 4.5) {  // a whole rocking period of the slipping block (physics.md 6)
+    while (sim.time() < 4.5) {  // a whole rocking period of the slipping block (docs/models.md)
       sim.run_until(sim.time() + 0.05);
       Vec2 cm{};
       const auto& p = sim.particles();

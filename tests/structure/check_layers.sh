@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The layering rules (architecture.md, style.md item 2), checked on the sources and on the built
+# The layering rules (docs/architecture.md, "Layers"), checked on the sources and on the built
 # core library. Usage: check_layers.sh SOURCE_DIR LIBDEM2D_CORE.a
 #   core/      physics: includes only core/ and the C++ standard library; no MPI, HDF5, TOML,
 #              METIS or fmt; its library references no MPI or HDF5 symbol;
