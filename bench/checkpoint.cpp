@@ -1,4 +1,4 @@
-// checkpoint: what writing and reading a checkpoint costs (issue 11), against particle count, on
+// checkpoint: what writing and reading a checkpoint costs, against particle count, on
 // the ranks the program is launched with:
 //
 //   build/bench/checkpoint [--particles 1e3,1e4,1e5,1e6] [--packing lattice|settled]

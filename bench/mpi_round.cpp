@@ -1,5 +1,5 @@
 // mpi_round: what one synchronisation costs between two ranks on this machine, the floor under
-// a parallel step (issue 3: why the 240-ball waterfall cannot run in half the time on 2 ranks).
+// a parallel step (why the 240-ball waterfall cannot run in half the time on 2 ranks).
 //
 //   OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun -np 2 build/bench/mpi_round
 //   [--results DIR]

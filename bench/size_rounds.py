@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The cost per particle-step from 1e4 to 1e6 particles, in rounds: issue 13's bound (within
+"""The cost per particle-step from 1e4 to 1e6 particles, in rounds: the size bound (within
 1.3x of the 1e4 cost) measured so that the machine's speed phases cancel.
 
     bench/size_rounds.py [--throughput build/bench/throughput] [--sizes 10000,30000,100000,1000000]
@@ -148,7 +148,7 @@ def plot(args, rows, path):
             ax.plot(*zip(*pts), marker=marker, alpha=0.5,
                     color="C0" if label == args.label else "grey",
                     label=label if rnd == 1 else None)
-    ax.axhline(BOUND, ls="--", color="C3", label=f"{BOUND}x bound (issue 13)")
+    ax.axhline(BOUND, ls="--", color="C3", label=f"{BOUND}x bound")
     ax.set_xscale("log")
     ax.set_xlabel("particles (deposited bed, one core)")
     ax.set_ylabel(f"cost per particle-step / cost at N = {args.sizes[0]}")

@@ -1,4 +1,4 @@
-// strong_scaling: the same scenes at 1 and 2 ranks (issue 3).
+// strong_scaling: the same scenes at 1 and 2 ranks.
 //
 //   build/bench/strong_scaling [--ranks 1,2] [--particles N1,N2,...] [--steps S] [--repeats R]
 //                              [--waterfall-time T] [--no-waterfall] [--no-plot] [--results DIR]

@@ -1,5 +1,5 @@
 // throughput: particle-steps per second of one core, how the cost scales with N and with the
-// size ratio, and what memory a particle takes (issue 13, "Fast at every size").
+// size ratio, and what memory a particle takes.
 //
 // Sections (--sections, default all but order, in this order):
 // drum       The settled polydisperse steel drum (bench/settled_drum.hpp: r uniform in
@@ -7,7 +7,7 @@
 //            mu_s = 0.1, mu_r = 0.05; hertz-mindlin + epsd; circular drum, sides = 0, fill
 //            fraction 0.31) for N = 1e3, 3e3, 1e4, 3e4, 1e5 (--particles): drum radius
 //            R = 2.5 m sqrt(N / 30 000), speed 1.5 rad/s sqrt(2.5 m / R) (Froude 0.57),
-//            dt = 1e-6 s. N = 3e4 is the issue-2 target scene (15 million particle-steps/s).
+//            dt = 1e-6 s. N = 3e4 is the reference scene (target 15 million particle-steps/s).
 //            N < 3e5 are settled by dynamics; N >= 3e5 given here are the deposited beds below.
 //            Steps per repeat: min(max(--steps, 3e7 / N), 3e8 / N): 30 000 at 1e3, 2 000 at
 //            3e4 and 1e5, 1 000 at 3e5, 300 at 1e6.
@@ -15,7 +15,7 @@
 //            no dynamics until the loading, so a million particles take minutes, not hours)
 //            for N = 1e4, 3e4, 1e5, 1e6 (--deposited): one recipe at every size, so the cost
 //            per particle-step is compared to the 1e4 bed of the same recipe (target of
-//            issue 13: within 1.3x up to 1e6). Measured in the material they are loaded in
+//            bound: within 1.3x up to 1e6). Measured in the material they are loaded in
 //            (steel with e = 0.1, mu_s = 0.5: the thesis steel cannot hold a deposited bed) and
 //            with the drum still (--deposited-speed F: F times the drum's full speed): started
 //            at full speed with this friction, the smaller beds dilate at the shell within the
@@ -26,7 +26,7 @@
 //            [10 mm / ratio, 10 mm] (ratio 1: all 10 mm), drum radius sqrt(sum r^2 / 0.31),
 //            speed as above, dt = 5e-7 s for every ratio (1 mm steel spheres need it); settled
 //            by the same three stages from a random sequential placement (settled_drum.hpp).
-//            Reported against the monodisperse cost (target of issue 13: 10:1 within 1.5x).
+//            Reported against the monodisperse cost (bound: 10:1 within 1.5x).
 //            Steps per repeat: max(--steps, 3e7 / N).
 // block      The dense sliding block: the thesis charge of inputs/waterfall_polygon.in (240
 //            balls of 0.1 m, friction 0.1) in a circular shell (--set drum.sides=0), through the
@@ -34,7 +34,7 @@
 //            ramp, then the charge slides and rocks as one block on the smooth shell), then
 //            --repeats segments of --block-time s (2.5 s) timed; contacts and candidate pairs
 //            per particle are the means of samples every 10 ms of the timed segments. Target of
-//            issue 13: 40 million particle-steps/s.
+//            target: 40 million particle-steps/s.
 // order      Storage order (run.spatial_sort, core/spatial_order.hpp): the drum packings of
 //            --order-particles (default 1e5, 1e6) with their ids as the fill gave them (row by
 //            row: spatially coherent) and shuffled (a fixed random permutation: ids spatially
@@ -151,8 +151,8 @@ double wall_list_bytes(const dem2d::WallPairList& l) {
 
 constexpr double kTargetRate = 15.0e6;    // particle-steps per second on one core
 constexpr double kTargetWaterfall = 5.0;  // s of wall time for the waterfall deck's 10 s
-constexpr double kTargetBlock = 40.0e6;   // particle-steps per second (issue 13)
-constexpr double kTargetRatioCost = 1.5;  // 10:1 against monodisperse (issue 13)
+constexpr double kTargetBlock = 40.0e6;   // particle-steps per second
+constexpr double kTargetRatioCost = 1.5;  // 10:1 against monodisperse
 constexpr int kWarmupSteps = 500;
 const char* const kDeck = DEM2D_SOURCE_DIR "/inputs/waterfall_polygon.in";
 
@@ -677,7 +677,7 @@ void deposited_section(const Options& opt, std::vector<Row>& rows) {
     for (const Row& r : dep)
       std::printf(
           "(d) deposited N = %lld: %.1f ns per particle-step = %.2f x the 1e4 bed's %.1f ns "
-          "(issue 13 target: <= 1.3 x); %.2f contacts and %.2f candidates per particle, %.0f "
+          "(bound: <= 1.3 x); %.2f contacts and %.2f candidates per particle, %.0f "
           "bytes of memory per particle\n",
           static_cast<long long>(r.n), r.ns_cpu(), r.ns_cpu() / base->ns_cpu(), base->ns_cpu(),
           r.contacts_per_particle, r.candidates_per_particle, r.rss_per_particle);
@@ -704,7 +704,7 @@ void ratio_section(const Options& opt, std::vector<Row>& rows) {
           "(r) size ratio %g: %.1f ns per particle-step = %.2f x the monodisperse %.1f "
           "ns%s\n",
           r.ratio, r.ns_cpu(), r.cost_vs_mono, base,
-          r.ratio == 10.0 ? " (issue 13 target: <= 1.5 x)" : "");
+          r.ratio == 10.0 ? " (bound: <= 1.5 x)" : "");
   }
   rows.insert(rows.end(), rat.begin(), rat.end());
 }
@@ -735,7 +735,7 @@ int main(int argc, char** argv) {
       std::printf(
           "(c) dense sliding block: %.3e particle-steps/s (CPU) = %.1f ns per "
           "particle-step, %.2f contacts per particle (%.2f particle-particle, the rest "
-          "with the shell); issue 13 target %.0f million/s\n",
+          "with the shell); target %.0f million/s\n",
           b.rate_cpu(), b.ns_cpu(), b.contacts_per_particle, b.pair_contacts_per_particle,
           kTargetBlock / 1e6);
       rows.push_back(b);

@@ -7,13 +7,13 @@ bench/throughput.
 
 Top left: nanoseconds per particle-step (CPU time of the fastest repeat; wall time dotted) of
 the drum runs against the particle count N (1e3 .. 1e5; the deposited beds, 1e4 .. 1e6, as
-triangles with their cost relative to the deposited 1e4 bed and the issue-13 bound of 1.3x), with the target of 15 million
+triangles with their cost relative to the deposited 1e4 bed and the bound of 1.3x), with the target of 15 million
 particle-steps per second (66.7 ns) as a horizontal line; flat means linear scaling. The dense
 sliding block and the waterfall deck are marked at their 240 balls (the block's target,
 40 million particle-steps/s = 25 ns, dashed). Top right: bytes per particle against N: the
 growth of resident memory, the particle store's fields and the pair lists with their
 histories. Bottom left: the size-ratio sweep (same N and fill fraction; r_max / r_min = 1, 2,
-5, 10): ns per particle-step and its ratio to the monodisperse cost, with the issue-13 target of
+5, 10): ns per particle-step and its ratio to the monodisperse cost, with the target of
 1.5x. Bottom right: contacts and candidate pairs per particle of every drum run.
 With --before, the runs of that CSV are drawn in grey for comparison (the same sections).
 The CSV may lack the columns added later (size_ratio, rss_bytes_per_particle, ...): those panels

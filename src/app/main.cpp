@@ -1,4 +1,4 @@
-// dem2d: command line, wiring and exit codes (interface.md). Everything else lives in the
+// dem2d: command line, wiring and exit codes (docs/architecture.md, "Command line and exit status"). Everything else lives in the
 // libraries: the deck and outputs in src/io, the physics in src/core, MPI in src/parallel.
 //
 // Exit status: 0 success, 2 bad input or usage, 3 the run became unstable, 4 an I/O failure,

@@ -7,7 +7,7 @@
 //   B. evaluate (SIMD): kinematics, contact law and rolling model, kPackSize contacts at a time
 //      (the batch is padded to a whole number of packs with copies of its last contact);
 //   C. scatter (scalar): forces, torques and histories back to the particles in canonical
-//      pair order, so each particle's sum is ordered by partner id (architecture.md).
+//      pair order, so each particle's sum is ordered by partner id (docs/architecture.md).
 // The law is the same template as for one contact, with selects instead of branches, so the
 // results do not depend on which lane a contact lands in.
 #pragma once

@@ -1,5 +1,5 @@
-// Contact history: the state a contact carries from step to step (architecture.md, style.md
-// items 5 and 7).
+// Contact history: the state a contact carries from step to step (docs/architecture.md,
+// "Contact histories").
 //
 // Each sub-model of the contact model (law, rolling model, tracker) declares the history it
 // needs as a list of slots (name, unit, meaning); a contact's history is the concatenation of

@@ -64,7 +64,7 @@ inline std::size_t padded(std::size_t n) { return (n + kPackSize - 1) / kPackSiz
 // ahead (Kernel::scatter_pairs).
 inline constexpr std::size_t kScatterPrefetchFrom = 50000;
 
-// The force loop for one contact model (style.md item 4: written once, the model chosen at
+// The force loop for one contact model (docs/architecture.md, "Code conventions": written once, the model chosen at
 // setup). Particle-particle contacts in canonical (lower id first, sorted) order, in chunks,
 // then particle-wall contacts; each in the three phases of contact_batch.hpp. Both paths call
 // Model::evaluate for the physics; they differ only in the geometry they gather and in what

@@ -1,4 +1,4 @@
-// Contact sub-models (physics.md sections 2-3), in three slots (style.md item 5):
+// Contact sub-models (docs/models.md, "Contact laws"), in three slots:
 //   law      normal and tangential force: HertzMindlin, ThesisModel, LinearModel;
 //   rolling  rolling resistance: RollingNone, RollingConstant, RollingEpsd;
 //   tracker  what a contact records for other models: TrackNone, TrackPeakEnergy;
@@ -76,7 +76,7 @@ struct ContactForceT {
   T k_prev_ratio = T(1.0);
   T dissipated = T(0.0);  // J in this step
   T elastic = T(0.0);     // J stored (normal + tangential springs)
-  T strain = T(0.0);      // J, the normal elastic energy the breakage law reads (physics.md 5)
+  T strain = T(0.0);      // J, the normal elastic energy the breakage law reads (docs/models.md, grinding)
   // The elastic part of f_n (N): the one force whose work is not booked in `dissipated` (its
   // work is the change of the elastic energy). The work of everything else (normal dashpot, the
   // whole tangential force, the rolling torque) is booked with the velocities the law sees; the
@@ -183,7 +183,7 @@ struct TangentialSpringHistory {
 // ---------------------------------------------------------------------------------------------
 // Laws
 
-// Hertz-Mindlin "no-slip" (seed 004, EDEM):
+// Hertz-Mindlin "no-slip" (the calibration study's model, as in EDEM):
 //   S_n = 2 E* sqrt(R* delta), F_n = 4/3 E* sqrt(R*) delta^1.5 - 2 sqrt(5/6) beta sqrt(S_n m*) v_n,
 //   S_t = 8 G* sqrt(R* delta), F_t = -S_t xi - 2 sqrt(5/6) beta sqrt(S_t m*) v_t, |F_t| <= mu_s
 //   F_n, beta mapped from the restitution asked for the clamped law (materials.hpp).
@@ -478,7 +478,7 @@ struct TrackNone : NoHistory {
 };
 
 // The largest strain energy of the contact so far (the breakage test reads it at the peak or
-// end of the contact, physics.md section 5).
+// end of the contact, docs/models.md, grinding).
 struct TrackPeakEnergy {
   static constexpr bool kExcludes = false;
   static constexpr std::array<HistorySlot, 1> kHistory{
@@ -492,7 +492,7 @@ struct TrackPeakEnergy {
   }
 };
 
-// Breakage (physics.md section 5): the peak strain energy, the energy at the end of the step
+// Breakage (docs/models.md, "Grinding: breakage, feed, sieve"): the peak strain energy, the energy at the end of the step
 // (the test runs when it has fallen below the peak: core/grinding.cpp), the peak level already
 // tested, and the birth overlap: bodies that overlapped when one of them was born (a fragment
 // inside its parent's circle) must not repel explosively (thesis), nor pass through each other.

@@ -1,4 +1,4 @@
-// Domain: the only way the physics talks to other processes (architecture.md).
+// Domain: the only way the physics talks to other processes (docs/architecture.md).
 //
 // The core calls these verbs at fixed points of a step; the serial implementation below is
 // trivial and is what the core's tests use. src/parallel/ implements them with MPI (angular

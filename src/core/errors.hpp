@@ -1,4 +1,4 @@
-// The errors dem2d reports to a user, each with its exit status (interface.md):
+// The errors dem2d reports to a user, each with its exit status (docs/architecture.md):
 // 2 bad input or usage, 3 the run became unstable, 4 an I/O failure, 5 interrupted by SIGINT or
 // SIGTERM after writing a checkpoint to resume from.
 #pragma once

@@ -1,4 +1,4 @@
-// Grinding: ore breakage, feed and sieve (physics.md section 5, thesis sections 1.8 and 2.3).
+// Grinding: ore breakage, feed and sieve (docs/models.md, "Grinding: breakage, feed, sieve").
 //
 // After every committed step of an ore scene (one with [breakage], [feed] or [sieve]):
 //   tests     every contact of a breakable particle whose strain energy has fallen below its

@@ -1,6 +1,6 @@
 // PairTable: the mixed properties of every ordered pair of materials, computed once.
 //
-// Effective moduli (physics.md section 2):
+// Effective moduli (docs/models.md, "Effective material values"):
 //   1/E* = (1 - nu_i^2)/E_i + (1 - nu_j^2)/E_j
 //   1/G* = 2 (2 - nu_i)(1 + nu_i)/E_i + 2 (2 - nu_j)(1 + nu_j)/E_j
 // Restitution, friction and rolling friction of a pair come from its [[interaction]] entry or,

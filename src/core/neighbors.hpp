@@ -2,7 +2,7 @@
 // candidate pairs within r_i + r_j + skin, and a list of candidate (particle, wall element)
 // contacts within r + skin of the element.
 //
-// Canonical order (architecture.md, Reproducibility): every pair is stored lower id first and
+// Canonical order (docs/architecture.md, "Reproducibility"): every pair is stored lower id first and
 // the list is sorted by (id_i, id_j). Scattering pair forces in that order adds the forces on
 // each particle in the order of its partners' ids, whatever the storage order or rank count.
 // When the particles are stored in spatial order the list is kept in storage order instead, and

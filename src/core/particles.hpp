@@ -10,7 +10,7 @@
 // that unit and description, and a test checks docs/output.md's table of snapshot datasets
 // against the marked fields (tests/io/test_output.cpp).
 //
-// Conventions (physics.md section 1): a particle is a sphere whose centre moves in the
+// Conventions (docs/models.md, "Bodies and frame"): a particle is a sphere whose centre moves in the
 // plane; mass m = 4/3 pi r^3 rho, moment of inertia I = 2/5 m r^2; angles and spins are
 // counter-clockwise positive.
 #pragma once

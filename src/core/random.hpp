@@ -1,6 +1,6 @@
 // Counter-based random numbers: a draw is a pure function of (run seed, key, counter), so the
 // same particle gets the same draw whatever rank owns it and in whatever order draws happen
-// (physics.md section 5). The mixer is SplitMix64's finaliser applied in a chain.
+// (docs/architecture.md, "Reproducibility"). The mixer is SplitMix64's finaliser applied in a chain.
 #pragma once
 
 #include <cmath>

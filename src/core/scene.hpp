@@ -139,7 +139,7 @@ struct WallSpec {
   Vec2 velocity{0.0, 0.0};  // a translating wall (moves rigidly)
 };
 
-// Ore breakage (physics.md section 5, thesis T34-T36): particles of one material break under the
+// Ore breakage (docs/models.md, thesis T34-T36): particles of one material break under the
 // peak strain energy of their contacts.
 struct BreakageSpec {
   bool present = false;
@@ -175,7 +175,7 @@ struct SieveSpec {
   std::string material;      // the material it lets through (ore)
   Vec2 box_min{-0.5, -0.5};  // thesis: 1 m x 1 m around the drum centre
   Vec2 box_max{0.5, 0.5};
-  double aperture = 0.04;  // m, compared with the radius (physics.md section 5)
+  double aperture = 0.04;  // m, compared with the radius (docs/models.md, "Sieve")
 };
 
 struct OutputSpec {

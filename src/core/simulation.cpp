@@ -461,7 +461,7 @@ std::string Simulation::unstable_reason(const StepOutcome& outcome, bool finite,
   if (!finite) {
     guard = Guard::kFinite;
     o << "non-finite positions or accelerations";
-    // interface.md (exit 3) asks for the particle ids: name this rank's first few.
+    // An unstable run's message names the particles (docs/architecture.md, exit 3): name this rank's first few.
     int named = 0;
     const ParticleStore& p = particles_;
     for (std::size_t k = 0; k < p.n_owned() && named < 5; ++k) {

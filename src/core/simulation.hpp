@@ -1,5 +1,5 @@
 // Simulation: one run of the particle system through time, wired from parts that each own
-// their state (architecture.md):
+// their state (docs/architecture.md):
 //   ParticleStore   the particles (core/particles.hpp)
 //   Walls           drum, lifters, segments at the current time (core/walls.hpp)
 //   ContactEngine   neighbour lists, contact histories, the contact model and its kernel

@@ -1,5 +1,5 @@
 // StateBackup: the last known good state of this rank's owned particles, so that a run that
-// blows up can still write a finite snapshot (interface.md, exit 3).
+// blows up can still write a finite snapshot (docs/architecture.md, exit 3).
 #pragma once
 
 #include <algorithm>

@@ -1,5 +1,5 @@
-// Time scales of a scene: what dt = "auto" picks and what a dt may not exceed (physics.md
-// section 4, interface.md --check).
+// Time scales of a scene: what dt = "auto" picks and what a dt may not exceed (docs/models.md,
+// "The time step, stability and guards"; shown by --check).
 #pragma once
 
 #include "core/particles.hpp"
@@ -7,7 +7,7 @@
 
 namespace dem2d {
 
-// Derived time scales of a scene (interface.md --check).
+// Derived time scales of a scene (shown by --check).
 struct TimeScales {
   double rayleigh = 0.0;         // s, smallest Rayleigh time pi r sqrt(rho/G)/(0.1631 nu + 0.8766)
   double hertz = 0.0;            // s, smallest Hertz contact time: particle pairs and walls

@@ -3,7 +3,7 @@
 // Bodies: the drum (rotating about its centre at Omega(t), linear ramp from 0 over ramp_time)
 // and each [[wall]] segment (static or translating). Elements: the drum's exact inner circle,
 // or the N sides of its regular polygon (vertices on the circle of the drum's radius, thesis
-// T 1.6), the three exposed sides of each rectangular lifter (seed 003), and straight segments.
+// T 1.6), the three exposed sides of each rectangular lifter (the DEM-FEM study, docs/models.md "Sources"), and straight segments.
 // Elements of the drum are stored in the drum frame and placed in the lab frame by `update`.
 //
 // The narrow phase of a particle against an element is its shape's (core/disc.hpp). In contact,

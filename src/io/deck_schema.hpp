@@ -878,7 +878,7 @@ inline constexpr Key<SieveSpec> kSieveKeys[] = {
      .range = kPositive,
      .field = member<&SieveSpec::aperture>(),
      .doc = "a particle of the material whose centre is in the zone and whose radius is below "
-            "this leaves the mill as product (physics.md section 5 compares the radius)"},
+            "this leaves the mill as product (the radius is compared)"},
 };
 
 inline constexpr Key<OutputSpec> kOutputKeys[] = {

@@ -1,4 +1,4 @@
-// Every MPI call of dem2d, as small verbs over a communicator (style.md item 2; CoMD's
+// Every MPI call of dem2d, as small verbs over a communicator (docs/architecture.md, "Code conventions"; CoMD's
 // parallel.c keeps all of its MPI in one file for the same reason). MpiDomain builds the
 // decomposition on these; src/io uses them for its collective decisions (row offsets of a
 // snapshot, agreeing on a failure) and takes only the MPI_Comm handle itself, which parallel
@@ -69,7 +69,7 @@ void exchange_bytes(MPI_Comm comm, std::span<const int> peers,
                     const std::vector<std::vector<std::byte>>& send,
                     std::vector<std::vector<std::byte>>& recv, std::vector<MPI_Request>& requests);
 
-// Agreeing on a failure (style.md item 9: never a throw on one rank that leaves the others
+// Agreeing on a failure (docs/architecture.md, "Code conventions": never a throw on one rank that leaves the others
 // waiting in a collective). `local_error` is this rank's failure message, empty if it
 // succeeded. Returns, on every rank, the message of the lowest failing rank, or an empty
 // string when no rank failed.

@@ -1,5 +1,5 @@
 // MpiDomain: the Domain verbs over MPI with the angular-sector decomposition
-// (architecture.md, Decomposition).
+// (docs/architecture.md, "Angular-sector domain decomposition").
 //
 // Regions. The plane is cut into n thin angular sectors about the drum centre (the scene
 // centre without a drum), sector_of() in parallel/sector_partition.hpp. METIS groups them into

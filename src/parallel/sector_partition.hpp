@@ -1,4 +1,4 @@
-// Angular-sector partition of the drum cross-section (issue 3: the MPI decomposition).
+// Angular-sector partition of the drum cross-section (the MPI decomposition).
 //
 // Sectors. The plane is cut into n thin angular sectors about the drum centre c. A point x has
 // the angle theta = atan2(x_y - c_y, x_x - c_x), mapped to [0, 2 pi) by adding 2 pi to negative

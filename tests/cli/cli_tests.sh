@@ -30,7 +30,7 @@ make_bad_decks() {
   sed -i 's/^model = "hertz-mindlin"/model = "hertz"/' "$tmp/model.in"
 }
 
-# grinding_ranks: grinding (issue 10): the ore deck on 1, 2 and 3 ranks, breakages, fragments,
+# grinding_ranks: grinding: the ore deck on 1, 2 and 3 ranks, breakages, fragments,
 # feed and sieve included: snapshots bit-identical by id, product.csv and breakages.csv
 # identical, and the mass balance initial + fed = mill + discharged to round-off at every row.
 grinding_ranks() {
@@ -164,7 +164,7 @@ EOF_PY
   then pass "no NaN in series.csv"; else fail "NaN/inf in series.csv"; fi
 }
 
-# waterfall_ranks: the same deck on 1, 2 and 3 ranks: snapshots bit-identical by id (issue 3),
+# waterfall_ranks: the same deck on 1, 2 and 3 ranks: snapshots bit-identical by id,
 # through the executable and the collective HDF5 writer; run.json gives each rank's work.
 waterfall_ranks() {
   local np

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The whole program on 8 ranks against 1 rank (issue 13: correctness past this machine's 2 cores;
+# The whole program on 8 ranks against 1 rank (correctness past this machine's 2 cores;
 # 8 ranks here are oversubscribed 4 to 1, so this checks bits, not speed). The centrifuge deck
 # with the drum at full speed from t = 0, 0.04 s: on 1 rank in one go; on 8 ranks to 0.02 s (the
 # snapshots and the checkpoint written collectively by 8 ranks), continued from that checkpoint

@@ -1,4 +1,4 @@
-// The angular-sector decomposition under MPI (issue 3). One binary, run by CTest at 1, 2, 3, 4
+// The angular-sector decomposition under MPI. One binary, run by CTest at 1, 2, 3, 4
 // and 5 ranks and at 8 (oversubscribed: tests/CMakeLists.txt); every assertion holds at every
 // rank count, and every rank owns particles in every scene (checked), 8 included.
 //

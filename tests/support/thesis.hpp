@@ -1,4 +1,4 @@
-// Shared test fixtures: the thesis's steel (seed 000, Table 1) and its drum.
+// Shared test fixtures: the thesis's steel (its Table 1) and its drum.
 #pragma once
 
 #include <random>
