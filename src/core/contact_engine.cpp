@@ -18,7 +18,7 @@ std::unique_ptr<ContactKernel> make_law_kernel(const ContactSpec& spec, const Pa
 }  // namespace kernels
 
 // The model is chosen here, once: one kernel per (law, rolling model, tracker, stepper), each
-// law's kernels compiled in its own file (kernels_*.cpp, contact_kernel.hpp).
+// law's kernels compiled in its own file (kernels_*.cpp, kernel_factory.hpp).
 // A rolling model is run only when some pair of materials has rolling friction: with mu_r = 0
 // everywhere it gives no torque and stores nothing (measured bit-identical to none), and the
 // epsd kernel cost 6 % more on such a scene.
@@ -52,8 +52,13 @@ void ContactEngine::build(const ParticleStore& p, const Walls& walls, double ski
   kernel_->lists_changed();
 }
 
+// The drive's torque and power are the first consumer of the wall loads.
 void ContactEngine::evaluate(ParticleStore& p, const Walls& walls, double dt) {
-  kernel_->evaluate(p, walls, pairs_, wall_pairs_, dt, totals_);
+  kernel_->evaluate(p, walls, pairs_, wall_pairs_, dt, totals_, wall_loads_);
+  const DriveLoads drive = drive_loads(wall_loads_, walls);
+  totals_.drum_torque = drive.drum_torque;
+  totals_.lifter_torque = drive.lifter_torque;
+  totals_.drive_power = drive.power;
 }
 
 void ContactEngine::commit() {

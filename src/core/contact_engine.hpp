@@ -24,6 +24,7 @@
 #include "core/neighbors.hpp"
 #include "core/particles.hpp"
 #include "core/scene.hpp"
+#include "core/wall_loads.hpp"
 #include "core/walls.hpp"
 
 namespace dem2d {
@@ -49,9 +50,11 @@ class ContactKernel {
   virtual ~ContactKernel() = default;
   virtual std::span<const HistorySlot> history_slots() const = 0;
   // Forces and torques of the listed contacts added to p.force and p.torque; trial histories
-  // written; totals of this rank.
+  // written; totals of this rank but the drive's; one load per wall contact into `loads`, in
+  // the wall list's order.
   virtual void evaluate(ParticleStore& p, const Walls& walls, PairList& pairs,
-                        WallPairList& wall_pairs, double dt, EvaluationTotals& totals) = 0;
+                        WallPairList& wall_pairs, double dt, EvaluationTotals& totals,
+                        std::vector<WallLoad>& loads) = 0;
   // The last evaluation's histories were committed / the lists were rebuilt or replaced.
   virtual void committed() = 0;
   virtual void lists_changed() = 0;
@@ -97,6 +100,8 @@ class ContactEngine {
   // See ContactKernel::breakage_tests_due.
   std::span<const std::int32_t> breakage_tests_due() const { return kernel_->breakage_tests_due(); }
   const EvaluationTotals& totals() const { return totals_; }
+  // The last evaluation's wall loads (core/wall_loads.hpp), this rank's, in the wall list's order.
+  std::span<const WallLoad> wall_loads() const { return wall_loads_; }
   // The trial histories become the committed ones.
   void commit();
 
@@ -128,6 +133,7 @@ class ContactEngine {
   PairList pairs_;
   WallPairList wall_pairs_;
   EvaluationTotals totals_;
+  std::vector<WallLoad> wall_loads_;
 };
 
 }  // namespace dem2d

@@ -11,16 +11,11 @@ namespace dem2d {
 
 void RebuildMonitor::record(const ParticleStore& p, const Walls& walls, double time) {
   pos_at_build_.assign(p.pos.data(), p.pos.data() + p.n_owned());
-  drum_angle_at_build_ = walls.drum_angle();
-  time_at_build_ = time;
+  walls_at_build_ = walls.pose(time);
 }
 
 bool RebuildMonitor::due(double displacement, const Walls& walls, double time, double ahead) const {
-  const double wall_move =
-      walls.rotating_reach() * (std::abs(walls.drum_angle() - drum_angle_at_build_) +
-                                std::abs(walls.drum_speed()) * ahead) +
-      walls.max_translation_speed() * (time + ahead - time_at_build_);
-  return 2.0 * displacement + wall_move >= skin_;
+  return 2.0 * displacement + walls.moved_since(walls_at_build_, time, ahead) >= skin_;
 }
 
 // ---------------------------------------------------------------------------------------------

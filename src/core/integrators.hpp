@@ -31,8 +31,8 @@
 namespace dem2d {
 
 // When the neighbour lists must be rebuilt: two particles approach by at most twice the largest
-// displacement since the last build, and a wall moves by at most rotating_reach * |drum angle
-// change| + translation speed * elapsed time (physics and lists: core/neighbors.hpp).
+// displacement since the last build, and a wall by at most what Walls::moved_since bounds
+// (physics and lists: core/neighbors.hpp).
 class RebuildMonitor {
  public:
   explicit RebuildMonitor(double skin = 0.0) : skin_(skin) {}
@@ -47,8 +47,7 @@ class RebuildMonitor {
  private:
   double skin_;
   Array<Vec2> pos_at_build_;
-  double drum_angle_at_build_ = 0.0;
-  double time_at_build_ = 0.0;
+  WallPose walls_at_build_;
 };
 
 // The stages of a step that belong to the simulation as a whole (core/simulation.cpp); an

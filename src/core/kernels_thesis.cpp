@@ -1,6 +1,6 @@
-// The thesis law's kernels (contact_kernel.hpp): every rolling model, tracker and
+// The thesis law's kernels (kernel_factory.hpp): every rolling model, tracker and
 // stepper.
-#include "core/contact_kernel.hpp"
+#include "core/kernel_factory.hpp"
 
 namespace dem2d::kernels {
 

@@ -3,8 +3,9 @@
 // Bodies: the drum (rotating about its centre at Omega(t), linear ramp from 0 over ramp_time)
 // and each [[wall]] segment (static or translating). Elements: the drum's exact inner circle,
 // or the N sides of its regular polygon (vertices on the circle of the drum's radius, thesis
-// T 1.6), the three exposed sides of each rectangular lifter (the DEM-FEM study, docs/models.md "Sources"), and straight segments.
-// Elements of the drum are stored in the drum frame and placed in the lab frame by `update`.
+// T 1.6), the three exposed sides of each rectangular lifter (the DEM-FEM study, docs/models.md
+// "Sources"), and straight segments. Elements of the drum are stored in the drum frame and placed
+// in the lab frame by `update`.
 //
 // The narrow phase of a particle against an element is its shape's (core/disc.hpp). In contact,
 // R* = r_i and m* = m_i, the wall's velocity at the contact point p is
@@ -12,6 +13,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -46,6 +48,17 @@ struct WallElement {
   Vec2 a{}, b{};          // segment ends in the lab frame at the current time
 };
 
+// Where the walls stood at a moment (a neighbour-list build): the time and the drum's angle.
+struct WallPose {
+  double time = 0.0;
+  double drum_angle = 0.0;
+};
+
+// The walls and their motion. The seam a wall motion plugs into is: update (where the elements
+// are at a time), elements (their ends), velocity_at (a point's velocity) and moved_since (how far
+// any element point may have moved since a pose); today's motions are prescribed rigid ones,
+// the drum's ramped rotation and the [[wall]] segments' translation (docs/extending.md, "A wall
+// motion").
 class Walls {
  public:
   Walls() = default;
@@ -60,10 +73,17 @@ class Walls {
     const WallBody& b = bodies_[body];
     return b.velocity + b.omega * perp(p - (b.center + b.offset));
   }
-  // Largest distance any rotating element point moves per unit drum angle (m/rad): bounds the
-  // wall motion between neighbour-list rebuilds. 0 when nothing but circles rotates.
-  double rotating_reach() const { return rotating_reach_; }
-  double max_translation_speed() const;
+  // The pose at `time` (the current one: update's).
+  WallPose pose(double time) const { return {time, drum_angle()}; }
+  // A bound on how far any element point moves from pose `then` to `ahead` seconds past `time`:
+  // the largest distance a rotating element point moves per unit drum angle (0 when nothing but
+  // circles rotates) times the angle turned, at most the full speed over `ahead`, plus the
+  // fastest translation over the time elapsed.
+  double moved_since(const WallPose& then, double time, double ahead) const {
+    return rotating_reach_ *
+               (std::abs(drum_angle() - then.drum_angle) + std::abs(drum_speed()) * ahead) +
+           max_translation_speed() * (time + ahead - then.time);
+  }
 
   const std::vector<WallBody>& bodies() const { return bodies_; }
   const std::vector<WallElement>& elements() const { return elements_; }
@@ -75,6 +95,7 @@ class Walls {
   double drum_speed() const { return has_drum() ? bodies_[drum_body_].speed : 0.0; }
 
  private:
+  double max_translation_speed() const;
   std::vector<WallBody> bodies_;
   std::vector<WallElement> elements_;
   int drum_body_ = -1;
