@@ -17,9 +17,17 @@
 
 #include "core/scene.hpp"
 #include "core/simulation.hpp"
+#include "support/scenes.hpp"
 
 namespace dem2d {
 namespace {
+
+using testing_support::ball;
+using testing_support::contact_scene;
+using testing_support::head_on_pair;
+using testing_support::make_material;
+using testing_support::rigid_wall_material;
+using testing_support::segment;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
@@ -43,25 +51,8 @@ constexpr Material kCopper{"copper", 120e9, 0.35, 8900};
 
 MaterialSpec spec(const Material& m, double restitution, double mu, double density_factor = 1.0,
                   const std::string& suffix = "") {
-  MaterialSpec s;
-  s.name = std::string(m.name) + suffix;
-  s.density = m.density * density_factor;
-  s.youngs_modulus = m.young;
-  s.poisson_ratio = m.nu;
-  s.shear_modulus = m.young / (2.0 * (1.0 + m.nu));
-  s.restitution = restitution;
-  s.sliding_friction = mu;
-  s.rolling_friction = 0.0;
-  return s;
-}
-
-// A rigid plane: E = 1e30; restitution and friction equal the ball's so the pair takes them.
-MaterialSpec rigid(const MaterialSpec& ball) {
-  MaterialSpec s = ball;
-  s.name = "rigid";
-  s.youngs_modulus = 1e30;
-  s.shear_modulus = 1e30 / (2.0 * (1.0 + s.poisson_ratio));
-  return s;
+  return make_material(std::string(m.name) + suffix, m.density * density_factor, m.young, m.nu,
+                       restitution, mu, 0.0);
 }
 
 double e_star_of(const Material& m) { return m.young / (1.0 - m.nu * m.nu); }
@@ -73,35 +64,15 @@ double hertz_time(double m_eff, double r_eff, double e_star, double v) {
 }
 
 Scene base_scene(double dt) {
-  Scene s;
-  s.title = "Chung & Ooi 2011";
-  s.run.dt_auto = false;
-  s.run.dt = dt;
-  s.run.gravity = {0.0, 0.0};
-  s.contact.model = ContactModelKind::kHertzMindlin;
-  s.contact.rolling = RollingModelKind::kNone;
-  return s;
-}
-
-ParticleSpec ball(const std::string& material, double r, Vec2 x, Vec2 v, double spin = 0.0) {
-  ParticleSpec p;
-  p.material = material;
-  p.radius = r;
-  p.position = x;
-  p.velocity = v;
-  p.spin = spin;
-  return p;
+  return contact_scene("Chung & Ooi 2011", dt, ContactModelKind::kHertzMindlin,
+                       RollingModelKind::kNone);
 }
 
 // A sphere of radius r just touching the floor y = 0 (no overlap yet) with velocity v and spin w.
 Scene sphere_on_plane(const MaterialSpec& m, double r, Vec2 v, double w, double dt) {
   Scene s = base_scene(dt);
-  s.materials = {m, rigid(m)};
-  WallSpec floor;
-  floor.from = {-1.0, 0.0};
-  floor.to = {1.0, 0.0};
-  floor.material = "rigid";
-  s.walls = {floor};
+  s.materials = {m, rigid_wall_material(m)};
+  s.walls = {segment({-1.0, 0.0}, {1.0, 0.0}, "rigid")};
   s.particles = {ball(m.name, r, {0.0, r}, v, w)};
   return s;
 }
@@ -155,7 +126,7 @@ void run_test1(const Material& m, double delta_max, double f_max, double t_c) {
   const double r = 0.01;
   Scene s = base_scene(t_c / 2000.0);
   s.materials = {spec(m, 1.0, 0.0)};
-  s.particles = {ball(m.name, r, {-r, 0.0}, {10.0, 0.0}), ball(m.name, r, {r, 0.0}, {-10.0, 0.0})};
+  s.particles = head_on_pair(m.name, r, r, 10.0);
   Simulation sim(s);
   const Impact imp = run_impact(sim, pair_overlap);
   expect_rel(imp.max_overlap, delta_max, 0.005, "peak overlap");

@@ -22,69 +22,37 @@
 #include "core/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
+#include "support/runs.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using testing_support::ball;
+using testing_support::contact_scene;
+using testing_support::head_on_pair;
+using testing_support::make_material;
+using testing_support::rigid_wall_material;
+using testing_support::segment;
 
-// A material with G = E / (2 (1 + nu)) set explicitly (the deck parser would derive it).
-MaterialSpec make_material(const std::string& name, double density, double young, double nu,
-                           double restitution, double mu_s, double mu_r = 0.0) {
-  MaterialSpec m;
-  m.name = name;
-  m.density = density;
-  m.youngs_modulus = young;
-  m.poisson_ratio = nu;
-  m.shear_modulus = young / (2.0 * (1.0 + nu));
-  m.restitution = restitution;
-  m.sliding_friction = mu_s;
-  m.rolling_friction = mu_r;
-  return m;
-}
+constexpr double kPi = std::numbers::pi;
 
 // Thesis Table 1 steel (E = 2e11, G = 8e10 -> nu = 0.25, rho = 7800).
 MaterialSpec steel(double restitution = 1.0, double mu_s = 0.3, double mu_r = 0.0) {
   return make_material("steel", 7800.0, 2.0e11, 0.25, restitution, mu_s, mu_r);
 }
 
-// A rigid wall: E huge, so E* = E/(1 - nu^2) of the sphere alone. Its restitution and friction
-// equal the ball's, so the pair's means are the ball's values.
+// A rigid wall (E huge, so E* = E/(1 - nu^2) of the sphere alone) of density 1000 kg/m^3. Its
+// restitution and friction equal the ball's, so the pair's means are the ball's values.
 MaterialSpec rigid_like(const MaterialSpec& ball) {
-  MaterialSpec m = make_material("rigid", 1000.0, 1.0e30, ball.poisson_ratio, ball.restitution,
-                                 ball.sliding_friction, ball.rolling_friction);
+  MaterialSpec m = rigid_wall_material(ball);
+  m.density = 1000.0;
   return m;
 }
 
 Scene base_scene(ContactModelKind model, RollingModelKind rolling, double dt = 1.0e-7) {
-  Scene s;
-  s.title = "contact law test";
-  s.run.dt_auto = false;
-  s.run.dt = dt;
-  s.run.gravity = {0.0, 0.0};
-  s.contact.model = model;
-  s.contact.rolling = rolling;
-  return s;
-}
-
-ParticleSpec ball(const std::string& material, double r, Vec2 x, Vec2 v = {}, double spin = 0.0) {
-  ParticleSpec p;
-  p.material = material;
-  p.radius = r;
-  p.position = x;
-  p.velocity = v;
-  p.spin = spin;
-  return p;
-}
-
-WallSpec segment(Vec2 from, Vec2 to, const std::string& material, Vec2 velocity = {}) {
-  WallSpec w;
-  w.from = from;
-  w.to = to;
-  w.material = material;
-  w.velocity = velocity;
-  return w;
+  return contact_scene("contact law test", dt, model, rolling);
 }
 
 double sphere_mass(double r, double rho) { return 4.0 / 3.0 * kPi * r * r * r * rho; }
@@ -888,8 +856,7 @@ Scene head_on_scene(bool track_peak_energy) {
   Scene s = base_scene(ContactModelKind::kHertzMindlin, RollingModelKind::kEpsd, 1.0e-7);
   s.contact.track_peak_energy = track_peak_energy;
   s.materials = {steel(1.0, 0.0, 0.1)};
-  s.particles = {ball("steel", 0.05, {-0.0501, 0.0}, {1.0, 0.0}),
-                 ball("steel", 0.05, {0.0501, 0.0}, {-1.0, 0.0})};
+  s.particles = head_on_pair("steel", 0.05, 0.0501, 1.0);
   return s;
 }
 
@@ -1040,11 +1007,7 @@ double ledger_error(ContactModelKind law, double dt, double phase, double mu_r,
     return r.kinetic_energy + r.rotational_energy + r.elastic_energy;
   };
   const double e0 = energy(sim.diagnostics());
-  bool touched = false;
-  while (sim.time() < 6.0e-3 && !(touched && sim.last_totals().contacts == 0)) {
-    sim.step();
-    touched = touched || sim.last_totals().contacts > 0;
-  }
+  const bool touched = testing_support::run_through_impact(sim, 6.0e-3).touched;
   const SeriesRow r = sim.diagnostics();
   EXPECT_TRUE(touched && r.contacts == 0) << "the spheres separated";
   const double loss = e0 - energy(r);
@@ -1131,11 +1094,7 @@ double rocking_energy(IntegratorKind integrator, double dt, double restitution) 
   s.run.gravity = {0.0, -9.81};
   s.run.integrator = integrator;
   s.materials = {steel(restitution, 10.0)};
-  s.walls = {segment({-1.0, 0.0}, {1.0, 0.0}, "steel")};
-  const double r = 0.05, m = sphere_mass(r, 7800.0);
-  const double e_star = 2.0e11 / (2.0 * (1.0 - 0.25 * 0.25));
-  const double delta0 = std::pow(m * 9.81 / (4.0 / 3.0 * e_star * std::sqrt(r)), 2.0 / 3.0);
-  s.particles = {ball("steel", r, {0.0, r - delta0}, {0.01, 0.0})};
+  testing_support::put_ball_on_steel_floor(s, 0.05, {0.01, 0.0});
   Simulation sim(s);
   sim.run_until(1.0e-3);
   const SeriesRow row = sim.diagnostics();

@@ -10,21 +10,14 @@
 #include "core/fill.hpp"
 #include "core/materials.hpp"
 #include "core/simulation.hpp"
+#include "support/scenes.hpp"
 
 namespace dem2d {
 namespace {
 
+// Steel (G = 8e10) with restitution 0.5, sliding friction 0.2, rolling friction 0.02.
 MaterialSpec steel(const std::string& name = "steel") {
-  MaterialSpec m;
-  m.name = name;
-  m.density = 7800;
-  m.youngs_modulus = 2e11;
-  m.poisson_ratio = 0.25;
-  m.shear_modulus = 8e10;
-  m.restitution = 0.5;
-  m.sliding_friction = 0.2;
-  m.rolling_friction = 0.02;
-  return m;
+  return testing_support::make_material(name, 7800, 2e11, 0.25, 0.5, 0.2, 0.02);
 }
 
 Scene drum_scene(int sides = 0) {
@@ -131,16 +124,8 @@ TEST(Fill, BoxRegionWithoutDrumAvoidsExplicitParticlesAndWalls) {
   Scene s;
   s.deck_path = "test.in";
   s.materials.push_back(steel());
-  ParticleSpec big;
-  big.material = "steel";
-  big.radius = 0.2;
-  big.position = {0.5, 0.5};
-  s.particles.push_back(big);
-  WallSpec w;
-  w.from = {0.0, 0.3};
-  w.to = {1.0, 0.3};
-  w.material = "steel";
-  s.walls.push_back(w);
+  s.particles.push_back(testing_support::ball("steel", 0.2, {0.5, 0.5}));
+  s.walls.push_back(testing_support::segment({0.0, 0.3}, {1.0, 0.3}, "steel"));
   FillSpec f = fill(60, 0.02, 0.04, FillRegion::kBox);
   f.box_min = {0.0, 0.0};
   f.box_max = {1.0, 1.0};

@@ -11,10 +11,14 @@
 #include "core/contact_models.hpp"
 #include "core/disc.hpp"
 #include "core/simulation.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
+
+using testing_support::ball;
+using testing_support::segment;
 
 // The ore of the thesis's Table 1.
 MaterialSpec thesis_ore() {
@@ -39,19 +43,9 @@ Scene impacts(int n, double r, double v, double strength) {
   s.run.gravity = {0.0, 0.0};
   s.run.dt_auto = true;
   s.run.seed = 7;
-  for (int k = 0; k < n; ++k) {
-    ParticleSpec p;
-    p.material = "ore";
-    p.radius = r;
-    p.position = {3.0 * r * k, r + 1e-3};
-    p.velocity = {0.0, -v};
-    s.particles.push_back(p);
-  }
-  WallSpec floor;
-  floor.from = {-r, 0.0};
-  floor.to = {3.0 * r * n, 0.0};
-  floor.material = "ore";
-  s.walls.push_back(floor);
+  for (int k = 0; k < n; ++k)
+    s.particles.push_back(ball("ore", r, {3.0 * r * k, r + 1e-3}, {0.0, -v}));
+  s.walls.push_back(segment({-r, 0.0}, {3.0 * r * n, 0.0}, "ore"));
   s.breakage.present = true;
   s.breakage.material = "ore";
   s.breakage.strength = strength;
@@ -159,11 +153,7 @@ TEST(Grinding, TheSieveRemovesOnlySmallOreInsideItsZone) {
   s.materials = {thesis_ore(), testing_support::thesis_steel()};
   s.run.gravity = {0.0, 0.0};
   const auto add = [&s](const char* material, double r, Vec2 x) {
-    ParticleSpec p;
-    p.material = material;
-    p.radius = r;
-    p.position = x;
-    s.particles.push_back(p);
+    s.particles.push_back(ball(material, r, x));
   };
   add("ore", 0.03, {0.0, 0.0});     // small ore inside: leaves
   add("ore", 0.03, {2.0, 0.0});     // small ore outside
@@ -221,11 +211,7 @@ TEST(Grinding, FedParticlesNeverOverlapAndTheMassBalanceHolds) {
 // after each contact its damage has grown by that contact's peak strain energy less E_min.
 TEST(Grinding, DamageAccumulatesOverImpacts) {
   Scene s = impacts(1, 0.05, 4.0, 1.0e-30);
-  WallSpec ceiling;
-  ceiling.from = {0.2, 0.3};
-  ceiling.to = {-0.2, 0.3};
-  ceiling.material = "ore";
-  s.walls.push_back(ceiling);
+  s.walls.push_back(segment({0.2, 0.3}, {-0.2, 0.3}, "ore"));  // a ceiling
   Simulation sim(s);
   const std::size_t slot = sim.contacts().history_offset("peak_energy");
   double expected = 0.0, peak = 0.0;
@@ -253,12 +239,7 @@ TEST(Grinding, BirthOverlapsEndWhenTheFragmentsPart) {
   s.particles[0].position = {0.0, 0.5};
   s.particles[0].spin = 80.0;
   // A second, smaller sphere (below minimum_radius: it does not break) strikes it head-on.
-  ParticleSpec hammer;
-  hammer.material = "ore";
-  hammer.radius = 0.04;  // below minimum_radius: it does not break
-  hammer.position = {0.0, 0.7};
-  hammer.velocity = {0.0, -3.0};
-  s.particles.push_back(hammer);
+  s.particles.push_back(ball("ore", 0.04, {0.0, 0.7}, {0.0, -3.0}));
   Simulation hit(s);
   while (hit.grinding()->totals().breakages == 0) {
     hit.step();
@@ -315,13 +296,7 @@ SizeLimitRun size_limit_run(bool fragments_known_to_dt) {
   s.breakage.fragments_mean = 6.0;  // every break makes 6: all fragments at the size limit
   s.breakage.fragments_min = 6;
   const double width = 3.0 * 0.041 * n;
-  for (double x : {-0.041, width}) {
-    WallSpec side;
-    side.from = {x, 0.0};
-    side.to = {x, 2.0};
-    side.material = "ore";
-    s.walls.push_back(side);
-  }
+  for (double x : {-0.041, width}) s.walls.push_back(segment({x, 0.0}, {x, 2.0}, "ore"));
   if (!fragments_known_to_dt) {  // the parents' step, fixed
     Scene parents = s;
     parents.breakage.present = false;

@@ -11,6 +11,7 @@
 #include "core/disc.hpp"
 #include "core/mill_analytics.hpp"
 #include "core/simulation.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
@@ -251,25 +252,10 @@ TEST(CollisionSpectra, ElasticImpactsBookTheirKineticEnergy) {
   s.output.collision_spectra = true;
   s.run.gravity = {0.0, 0.0};
   const double v = 1.0;
-  for (const double x : {-0.2, 0.2}) {
-    ParticleSpec b;
-    b.material = "steel";
-    b.radius = kBall;
-    b.position = {x, 1.0};
-    b.velocity = {x < 0 ? v : -v, 0.0};
-    s.particles.push_back(b);
-  }
-  ParticleSpec c;
-  c.material = "steel";
-  c.radius = kBall;
-  c.position = {3.0, 0.5};
-  c.velocity = {0.0, -v};
-  s.particles.push_back(c);
-  WallSpec floor;
-  floor.from = {2.0, 0.0};
-  floor.to = {4.0, 0.0};
-  floor.material = "steel";
-  s.walls.push_back(floor);
+  for (const double x : {-0.2, 0.2})
+    s.particles.push_back(testing_support::ball("steel", kBall, {x, 1.0}, {x < 0 ? v : -v, 0.0}));
+  s.particles.push_back(testing_support::ball("steel", kBall, {3.0, 0.5}, {0.0, -v}));
+  s.walls.push_back(testing_support::segment({2.0, 0.0}, {4.0, 0.0}, "steel"));
   Simulation sim(s);
   sim.run_until(0.6);
   const CollisionSpectra& spectra = *sim.spectra();

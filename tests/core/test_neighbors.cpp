@@ -16,6 +16,7 @@
 #include "core/random.hpp"
 #include "core/simulation.hpp"
 #include "core/walls.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
@@ -86,8 +87,8 @@ struct Config {
   NeighborSearch::Levels levels = NeighborSearch::Levels::kAuto;
 };
 
-// Random configuration (overlaps allowed: the search does not care) of 600 particles.
-void check_config(const Config& c) {
+// The walls of a configuration: a drum (with lifters if polygonal) or two wall segments.
+Scene config_scene(const Config& c) {
   Scene s;
   s.materials.push_back(steel());
   if (c.shell != Shell::kNone) {
@@ -104,16 +105,15 @@ void check_config(const Config& c) {
       s.drum.lifters.push_back(l);
     }
   } else {
-    WallSpec w;
-    w.material = "steel";
-    w.from = {-1.6, -1.6};
-    w.to = {1.6, -1.6};
-    s.walls.push_back(w);
-    w.from = {-1.6, 1.0};
-    w.to = {0.5, -0.4};
-    s.walls.push_back(w);
+    s.walls.push_back(testing_support::segment({-1.6, -1.6}, {1.6, -1.6}, "steel"));
+    s.walls.push_back(testing_support::segment({-1.6, 1.0}, {0.5, -0.4}, "steel"));
   }
-  const Walls walls(s);
+  return s;
+}
+
+// Random configuration (overlaps allowed: the search does not care) of 600 particles.
+void check_config(const Config& c) {
+  const Walls walls(config_scene(c));
   const double r_max = 0.06, r_min = r_max / c.size_ratio;
   const int n = 600;
   std::vector<std::int64_t> ids(n);
@@ -214,19 +214,9 @@ Scene sliding_scene() {
   s.deck_path = "test_neighbors";
   s.materials.push_back(steel());
   s.run.dt_auto = true;
-  WallSpec w;
-  w.from = {-5.0, 0.0};
-  w.to = {5.0, 0.0};
-  w.material = "steel";
-  s.walls.push_back(w);
+  s.walls.push_back(testing_support::segment({-5.0, 0.0}, {5.0, 0.0}, "steel"));
   auto add = [&](Vec2 x, Vec2 v, double spin) {
-    ParticleSpec p;
-    p.material = "steel";
-    p.radius = 0.1;
-    p.position = x;
-    p.velocity = v;
-    p.spin = spin;
-    s.particles.push_back(p);
+    s.particles.push_back(testing_support::ball("steel", 0.1, x, v, spin));
   };
   // Overlaps of 2 um (the steel Hertz overlap under one ball's weight is 4.7 um).
   const double y0 = 0.1 - 2e-6, d = 0.2 - 2e-6, a = std::numbers::pi / 3.0;

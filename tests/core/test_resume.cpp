@@ -4,15 +4,16 @@
 // cli tests.)
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <numeric>
 
 #include "core/simulation.hpp"
+#include "support/compare.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
 
+using testing_support::expect_same_particles;
 using testing_support::thesis_drum_scene;
 
 // What a checkpoint would hold of `sim` (one rank: every particle is owned here).
@@ -30,30 +31,6 @@ Resumption resumption_of(const Simulation& sim) {
   }
   r.histories = sim.histories();
   return r;
-}
-
-// Every registered field of every particle, bit for bit, matched by id.
-void expect_same_particles(const Simulation& a, const Simulation& b) {
-  const ParticleStore& p = a.particles();
-  const ParticleStore& q = b.particles();
-  ASSERT_EQ(p.n_owned(), q.n_owned());
-  std::vector<std::size_t> in_q(p.n_owned());
-  for (std::size_t k = 0; k < q.n_owned(); ++k)
-    for (std::size_t m = 0; m < p.n_owned(); ++m)
-      if (p.id[m] == q.id[k]) in_q[m] = k;
-  for (std::size_t f = 0; f < p.fields().size(); ++f) {
-    const FieldBase& fa = *p.fields()[f];
-    const FieldBase& fb = *q.fields()[f];
-    const std::size_t w = fa.bytes_per_item();
-    std::vector<std::byte> x(w), y(w);
-    int differ = 0;
-    for (std::size_t m = 0; m < p.n_owned(); ++m) {
-      fa.pack(m, x.data());
-      fb.pack(in_q[m], y.data());
-      differ += std::memcmp(x.data(), y.data(), w) != 0;
-    }
-    EXPECT_EQ(differ, 0) << "field " << fa.name();
-  }
 }
 
 void expect_same_ledger(const Simulation& a, const Simulation& b) {

@@ -13,6 +13,7 @@
 
 #include "core/scene.hpp"
 #include "core/simulation.hpp"
+#include "support/scenes.hpp"
 
 namespace dem2d {
 namespace {
@@ -25,19 +26,6 @@ constexpr double kYoung = 2.0e11;  // Pa
 constexpr double kNu = 0.25;
 constexpr double kDt = 2.0e-5;  // s: ~125 steps per normal and ~70 per tangential period
 
-MaterialSpec material(const std::string& name, double young, double mu_s, double mu_r) {
-  MaterialSpec m;
-  m.name = name;
-  m.density = kDensity;
-  m.youngs_modulus = young;
-  m.poisson_ratio = kNu;
-  m.shear_modulus = young / (2.0 * (1.0 + kNu));
-  m.restitution = 0.5;
-  m.sliding_friction = mu_s;
-  m.rolling_friction = mu_r;
-  return m;
-}
-
 // A steel ball on a rigid wall through the origin with downhill direction (cos t, -sin t)
 // (t = 0: a floor), resting at the static overlap under gravity, with velocity v along the slope
 // (positive downhill) and spin w.
@@ -49,29 +37,18 @@ struct Incline {
   Incline(double t, double mu_s, double mu_r, RollingModelKind rolling, double v = 0.0,
           double w = 0.0)
       : angle(t), downhill{std::cos(t), -std::sin(t)}, up_normal{std::sin(t), std::cos(t)} {
-    scene.title = "rolling test";
-    scene.run.dt_auto = false;
-    scene.run.dt = kDt;
-    scene.run.gravity = {0.0, -kG};
-    scene.contact.model = ContactModelKind::kHertzMindlin;
-    scene.contact.rolling = rolling;
-    scene.materials = {material("steel", kYoung, mu_s, mu_r), material("rigid", 1e30, mu_s, mu_r)};
-    WallSpec wall;
-    wall.from = -3.0 * downhill;
-    wall.to = 3.0 * downhill;
-    wall.material = "rigid";
-    scene.walls = {wall};
+    scene = testing_support::contact_scene("rolling test", kDt, ContactModelKind::kHertzMindlin,
+                                           rolling, {0.0, -kG});
+    const MaterialSpec steel =
+        testing_support::make_material("steel", kDensity, kYoung, kNu, 0.5, mu_s, mu_r);
+    scene.materials = {steel, testing_support::rigid_wall_material(steel)};
+    scene.walls = {testing_support::segment(-3.0 * downhill, 3.0 * downhill, "rigid")};
     const double m = 4.0 / 3.0 * kPi * kR * kR * kR * kDensity;
     const double e_star = kYoung / (1 - kNu * kNu);
     const double delta =
         std::pow(m * kG * std::cos(t) / (4.0 / 3.0 * e_star * std::sqrt(kR)), 2.0 / 3.0);
-    ParticleSpec p;
-    p.material = "steel";
-    p.radius = kR;
-    p.position = (kR - delta) * up_normal;
-    p.velocity = v * downhill;
-    p.spin = w;
-    scene.particles = {p};
+    scene.particles = {
+        testing_support::ball("steel", kR, (kR - delta) * up_normal, v * downhill, w)};
   }
   double speed(const Simulation& sim) const { return dot(sim.particles().vel[0], downhill); }
   double distance(const Simulation& sim) const { return dot(sim.particles().pos[0], downhill); }

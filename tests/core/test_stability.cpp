@@ -16,11 +16,14 @@
 #include "core/disc.hpp"
 #include "core/errors.hpp"
 #include "core/simulation.hpp"
+#include "support/runs.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
 
+using testing_support::head_on_pair;
 using testing_support::thesis_steel;
 
 Scene base_scene(IntegratorKind integrator = IntegratorKind::kVerlet) {
@@ -33,13 +36,7 @@ Scene base_scene(IntegratorKind integrator = IntegratorKind::kVerlet) {
 }
 
 void add_ball(Scene& s, Vec2 x, Vec2 v, double r, double spin = 0.0) {
-  ParticleSpec p;
-  p.material = "steel";
-  p.radius = r;
-  p.position = x;
-  p.velocity = v;
-  p.spin = spin;
-  s.particles.push_back(p);
+  s.particles.push_back(testing_support::ball("steel", r, x, v, spin));
 }
 
 // The thesis drum (radius 2.5 m, regular polygon) with n balls of radius 0.1 m from the bottom.
@@ -47,11 +44,6 @@ Scene drum_scene(int n, double speed, int sides) {
   Scene s = testing_support::thesis_drum_scene(n, speed, sides);
   s.deck_path = "test_stability";
   return s;
-}
-
-double balance(const SeriesRow& r) {
-  return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
-         r.dissipated_energy - r.drive_work;
 }
 
 bool all_finite(const ParticleStore& p) {
@@ -83,8 +75,7 @@ HeadOn head_on(double e, IntegratorKind integrator) {
   Scene s = base_scene(integrator);
   s.materials[0] = thesis_steel(e);
   s.run.gravity = {0.0, 0.0};
-  add_ball(s, {-0.11, 0.0}, {20.0, 0.0}, 0.1);
-  add_ball(s, {0.11, 0.0}, {-20.0, 0.0}, 0.1);
+  s.particles = head_on_pair("steel", 0.1, 0.11, 20.0);
   Simulation sim(s);
   HeadOn out;
   out.dt = sim.dt();
@@ -107,8 +98,7 @@ TEST(Stability, AutoDtResolvesAHeadOnPairWithTheIntendedSteps) {
     Scene s = base_scene(IntegratorKind::kVerlet);
     s.materials[0] = thesis_steel(e);
     s.run.gravity = {0.0, 0.0};
-    add_ball(s, {-0.11, 0.0}, {20.0, 0.0}, 0.1);
-    add_ball(s, {0.11, 0.0}, {-20.0, 0.0}, 0.1);
+    s.particles = head_on_pair("steel", 0.1, 0.11, 20.0);
     Simulation sim(s);
     int steps_in_contact = 0;
     while (sim.time() < 2e-3) {
@@ -171,11 +161,7 @@ TEST(Stability, HeadOnRestitutionRangeAtAutoDt) {
 TEST(Stability, SizeRatioTenRestingAndImpacting) {
   for (IntegratorKind integrator : {IntegratorKind::kVerlet, IntegratorKind::kIterative}) {
     Scene s = base_scene(integrator);
-    WallSpec w;
-    w.from = {-5.0, 0.0};
-    w.to = {5.0, 0.0};
-    w.material = "steel";
-    s.walls.push_back(w);
+    s.walls.push_back(testing_support::segment({-5.0, 0.0}, {5.0, 0.0}, "steel"));
     add_ball(s, {0.0, 0.1}, {}, 0.1);
     add_ball(s, {0.0, 0.21}, {}, 0.01);
     add_ball(s, {1.0, 0.1}, {}, 0.1);
@@ -183,7 +169,7 @@ TEST(Stability, SizeRatioTenRestingAndImpacting) {
     add_ball(s, {2.0, 0.01}, {}, 0.01);
     add_ball(s, {2.05, 0.4}, {}, 0.1);
     Simulation sim(s);
-    const double e0 = balance(sim.diagnostics());
+    const double e0 = energy_balance(sim.diagnostics());
     double max_overlap = 0.0;
     bool hit_small = false, hit_big = false;
     while (sim.time() < 0.5) {
@@ -195,7 +181,7 @@ TEST(Stability, SizeRatioTenRestingAndImpacting) {
     }
     const SeriesRow r = sim.diagnostics();
     const ParticleStore& p = sim.particles();
-    const double residual = (balance(r) - e0) / r.dissipated_energy;
+    const double residual = (energy_balance(r) - e0) / r.dissipated_energy;
     std::cout << "[ size ratio 10 ] " << integrator_name(integrator) << " dt " << sim.dt() << " s, "
               << sim.step_count() << " steps: max overlap " << max_overlap
               << " of the smaller radius, "
@@ -271,13 +257,8 @@ TEST(Stability, ParticlesTouchingTheShellAtStartAreNotEjected) {
 TEST(Stability, CentrifugeSceneRunsTenSeconds) {
   Scene s = drum_scene(120, 10.0, 16);
   Simulation sim(s);
-  const double e0 = balance(sim.diagnostics());
-  double max_overlap = 0.0;
+  const auto [max_overlap, residual] = testing_support::run_drum(sim, 10.0);
   double worst_penetration = -1.0;  // of the radius, into the shell
-  while (sim.time() + 0.5 * sim.dt() < 10.0) {
-    sim.step();
-    max_overlap = std::max(max_overlap, sim.last_totals().max_overlap);
-  }
   const ParticleStore& p = sim.particles();
   double l = 0.0, inertia = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
@@ -289,7 +270,6 @@ TEST(Stability, CentrifugeSceneRunsTenSeconds) {
     inertia += p.mass[k] * norm2(p.pos[k]);
   }
   const SeriesRow r = sim.diagnostics();
-  const double residual = (balance(r) - e0) / r.drive_work;
   std::cout << "[ centrifuge ] 10 s at dt " << sim.dt() << " s: max overlap " << max_overlap
             << " r, balance residual " << residual << " of the drive work " << r.drive_work
             << " J, charge omega " << l / inertia << " rad/s at 10 s\n";
@@ -407,8 +387,7 @@ Scene head_on_impact() {
   s.materials[0] = thesis_steel(0.73);
   s.run.gravity = {0.0, 0.0};
   s.run.duration = 0.01;
-  add_ball(s, {-0.11, 0.0}, {5.0, 0.0}, 0.1);
-  add_ball(s, {0.11, 0.0}, {-5.0, 0.0}, 0.1);
+  s.particles = head_on_pair("steel", 0.1, 0.11, 5.0);
   return s;
 }
 
@@ -468,15 +447,7 @@ TEST(Stability, UnsettledIterativePassesAreAnError) {
   s.materials[0] = thesis_steel(0.5);
   s.materials[0].sliding_friction = 10.0;  // the ball rocks on its tangential spring
   s.materials[0].rolling_friction = 0.0;
-  WallSpec floor;
-  floor.from = {-1.0, 0.0};
-  floor.to = {1.0, 0.0};
-  floor.material = "steel";
-  s.walls = {floor};
-  const double r = 0.05, m = 4.0 / 3.0 * std::numbers::pi * r * r * r * 7800.0;
-  const double e_star = 2.0e11 / (2.0 * (1.0 - 0.25 * 0.25));
-  const double delta0 = std::pow(m * 9.81 / (4.0 / 3.0 * e_star * std::sqrt(r)), 2.0 / 3.0);
-  add_ball(s, {0.0, r - delta0}, {0.01, 0.0}, r);
+  testing_support::put_ball_on_steel_floor(s, 0.05, {0.01, 0.0});
   s.run.duration = 0.01;
   {
     Simulation sim(s);
@@ -561,7 +532,7 @@ TEST(Stability, LargestDtSurvivedInTheWaterfallScene) {
       hot.run.dt = dt;
       hot.run.integrator = integrator;
       Simulation sim(hot);
-      const double e0 = balance(sim.diagnostics());
+      const double e0 = energy_balance(sim.diagnostics());
       try {
         sim.run_until(0.3);
       } catch (const UnstableError& e) {
@@ -572,7 +543,7 @@ TEST(Stability, LargestDtSurvivedInTheWaterfallScene) {
         break;
       }
       const SeriesRow r = sim.diagnostics();
-      const double residual = (balance(r) - e0) / r.dissipated_energy;
+      const double residual = (energy_balance(r) - e0) / r.dissipated_energy;
       const double unconverged = static_cast<double>(sim.unconverged_steps()) / sim.step_count();
       std::cout << "[ largest dt ] " << integrator_name(integrator) << " dt " << dt << " s ("
                 << dt / auto_dt << " x auto): survived 0.3 s; balance residual " << residual

@@ -28,6 +28,8 @@
 #include "core/disc.hpp"
 #include "core/random.hpp"
 #include "core/simulation.hpp"
+#include "support/runs.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
@@ -35,6 +37,9 @@ namespace {
 
 constexpr double kG = 9.81;
 
+using testing_support::ball;
+using testing_support::max_speed;
+using testing_support::segment;
 using testing_support::thesis_steel;
 
 // Thesis drum (radius 2.5 m) with n balls of radius 0.1 m filled from the bottom.
@@ -50,19 +55,8 @@ Scene drum_scene(int n, double speed, int sides, double dt,
   return s;
 }
 
-// kinetic + rotational + potential + elastic + dissipated - drive work (constant in theory).
-double balance(const SeriesRow& r) {
-  return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy +
-         r.dissipated_energy - r.drive_work;
-}
 double mechanical(const SeriesRow& r) {
   return r.kinetic_energy + r.rotational_energy + r.potential_energy + r.elastic_energy;
-}
-
-double max_speed(const ParticleStore& p) {
-  double v = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) v = std::max(v, norm(p.vel[k]));
-  return v;
 }
 
 struct ChargeState {
@@ -110,13 +104,13 @@ double conservative_error(ContactModelKind model, double dt, std::uint64_t seed)
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     p.vel[k] = {2.0 * random_uniform(seed, 77, 2 * k) - 1.0,
                 2.0 * random_uniform(seed, 77, 2 * k + 1) - 1.0};
-  const double e0 = balance(sim.diagnostics());
+  const double e0 = energy_balance(sim.diagnostics());
   double dev = 0.0, ke = 0.0;
   while (sim.time() + 0.5 * dt < 0.5) {
     sim.step();
     if (sim.step_count() % 5 == 0) {
       const SeriesRow r = sim.diagnostics();
-      dev = std::max(dev, std::abs(balance(r) - e0));
+      dev = std::max(dev, std::abs(energy_balance(r) - e0));
       ke = std::max(ke, r.kinetic_energy);
     }
   }
@@ -162,10 +156,10 @@ TEST(SystemEnergy, BalanceResidualWithFrictionIsSmallAndSecondOrder) {
   double rel[4];
   for (int k = 0; k < 4; ++k) {
     Simulation sim(drum_scene(60, 1.8, 8, dts[k]));
-    const double e0 = balance(sim.diagnostics());
+    const double e0 = energy_balance(sim.diagnostics());
     sim.run_until(1.0);
     const SeriesRow r = sim.diagnostics();
-    rel[k] = (balance(r) - e0) / r.dissipated_energy;
+    rel[k] = (energy_balance(r) - e0) / r.dissipated_energy;
     std::cout << "[ energy ] thesis steel, 8-gon 1.8 rad/s, 1 s: dt " << dts[k]
               << " s: residual / dissipated = " << rel[k] << " (dissipated " << r.dissipated_energy
               << " J, drive work " << r.drive_work << " J)\n";
@@ -229,12 +223,8 @@ LoneBall lone_ball(RollingModelKind rolling) {
   Scene s = drum_scene(0, 0.0, 0, 1e-5);
   s.fills.clear();
   s.contact.rolling = rolling;
-  ParticleSpec b;
-  b.material = "steel";
-  b.radius = 0.1;
   const double a = 10.0 * std::numbers::pi / 180.0, d = 2.5 - 0.1;
-  b.position = {d * std::sin(a), -d * std::cos(a)};
-  s.particles.push_back(b);
+  s.particles.push_back(ball("steel", 0.1, {d * std::sin(a), -d * std::cos(a)}));
   Simulation sim(s);
   const SeriesRow r0 = sim.diagnostics();
   sim.run_until(4.0);
@@ -425,19 +415,9 @@ Scene three_balls(double dt, IntegratorKind integrator) {
   s.run.dt_auto = false;
   s.run.dt = dt;
   s.run.integrator = integrator;
-  WallSpec w;
-  w.from = {-5.0, 0.0};
-  w.to = {5.0, 0.0};
-  w.material = "steel";
-  s.walls.push_back(w);
+  s.walls.push_back(segment({-5.0, 0.0}, {5.0, 0.0}, "steel"));
   auto add = [&](Vec2 x, Vec2 v, double spin, double r) {
-    ParticleSpec p;
-    p.material = "steel";
-    p.radius = r;
-    p.position = x;
-    p.velocity = v;
-    p.spin = spin;
-    s.particles.push_back(p);
+    s.particles.push_back(ball("steel", r, x, v, spin));
   };
   add({0.0, 0.1}, {0.0, 0.0}, 0.0, 0.1);
   add({-0.6, 0.35}, {3.0, -1.0}, 20.0, 0.1);
@@ -502,18 +482,10 @@ TEST(SystemIntegrators, IterativeConvergesOnlyBelowSqrt6) {
     s.materials.push_back(m);
     s.contact.model = ContactModelKind::kLinear;
     s.contact.rolling = RollingModelKind::kNone;
-    WallSpec w;
-    w.from = {-1.0, 0.0};
-    w.to = {1.0, 0.0};
-    w.material = "steel";
-    s.walls.push_back(w);
+    s.walls.push_back(segment({-1.0, 0.0}, {1.0, 0.0}, "steel"));
     const double mass = Disc::mass(0.1, 7800.0);
     const double delta_eq = mass * kG / m.normal_stiffness;
-    ParticleSpec b;
-    b.material = "steel";
-    b.radius = 0.1;
-    b.position = {0.0, 0.1 - 1.5 * delta_eq};
-    s.particles.push_back(b);
+    s.particles.push_back(ball("steel", 0.1, {0.0, 0.1 - 1.5 * delta_eq}));
     s.run.integrator = IntegratorKind::kIterative;
     s.run.dt_auto = false;
     s.run.dt = omega_dt / std::sqrt(m.normal_stiffness / mass);

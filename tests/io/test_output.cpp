@@ -30,6 +30,7 @@
 #include "io/output_dir.hpp"
 #include "io/series.hpp"
 #include "io/snapshots.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
@@ -87,15 +88,7 @@ class ScratchDir {
 };
 
 std::vector<MaterialSpec> test_materials() {
-  MaterialSpec steel;
-  steel.name = "steel";
-  steel.density = 7800.0;
-  steel.youngs_modulus = 2.0e11;
-  steel.poisson_ratio = 0.25;
-  steel.shear_modulus = 8.0e10;
-  steel.restitution = 0.73;
-  steel.sliding_friction = 0.1;
-  steel.rolling_friction = 0.05;
+  const MaterialSpec steel = testing_support::thesis_steel();
   MaterialSpec ore;
   ore.name = "iron ore";
   ore.density = 3500.0;

@@ -33,6 +33,7 @@
 
 #include "core/simulation.hpp"
 #include "parallel/mpi_domain.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace {
@@ -496,11 +497,8 @@ TEST(Reproducibility, PackingInContactFromTheFirstStep) {
     for (int i = -14; i <= 14; ++i) {
       const Vec2 x{(i + 0.5 * (j & 1)) * pitch, j * row};
       if (norm(x) > 0.25) continue;
-      ParticleSpec p;
-      p.material = "steel";
-      p.radius = (i * 7 + j * 3) % 2 == 0 ? 0.0100 : 0.0095;
-      p.position = x;
-      s.particles.push_back(p);
+      s.particles.push_back(
+          testing_support::ball("steel", (i * 7 + j * 3) % 2 == 0 ? 0.0100 : 0.0095, x));
     }
   expect_same_as_serial(
       s, 1000, 100,

@@ -12,27 +12,17 @@
 
 #include "core/disc.hpp"
 #include "core/simulation.hpp"
+#include "support/runs.hpp"
+#include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
 
+using testing_support::ball;
+using testing_support::max_speed;
+using testing_support::run_drum;
 using testing_support::thesis_steel;
-
-ParticleSpec ball(double r, Vec2 x, Vec2 v = {}) {
-  ParticleSpec p;
-  p.material = "steel";
-  p.radius = r;
-  p.position = x;
-  p.velocity = v;
-  return p;
-}
-
-double max_speed(const ParticleStore& p) {
-  double v = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) v = std::max(v, norm(p.vel[k]));
-  return v;
-}
 
 // Two 1 mm steel spheres head-on at 2 x 25 m/s: the contact lasts about 5 us, and dt = "auto"
 // resolves it. The restitution obtained is the one asked within 1 %, the overlap stays far below
@@ -43,17 +33,10 @@ TEST(HardCases, MillimetreSpheresAt25MetresPerSecond) {
     s.deck_path = "hard cases";
     s.materials = {thesis_steel(e)};
     s.run.gravity = {0.0, 0.0};
-    s.particles = {ball(0.5e-3, {-0.6e-3, 0.0}, {25.0, 0.0}),
-                   ball(0.5e-3, {0.6e-3, 0.0}, {-25.0, 0.0})};
+    s.particles = testing_support::head_on_pair("steel", 0.5e-3, 0.6e-3, 25.0);
     Simulation sim(s);
     const SeriesRow r0 = sim.diagnostics();
-    double max_overlap = 0.0;
-    bool touched = false;
-    while (sim.time() < 1e-4 && !(touched && sim.last_totals().contacts == 0)) {
-      sim.step();
-      touched = touched || sim.last_totals().contacts > 0;
-      max_overlap = std::max(max_overlap, sim.last_totals().max_overlap);
-    }
+    const auto [touched, max_overlap] = testing_support::run_through_impact(sim, 1e-4);
     const SeriesRow r = sim.diagnostics();
     const double e_obtained = (sim.particles().vel[1].x - sim.particles().vel[0].x) / 50.0;
     const double lost = r0.kinetic_energy - r.kinetic_energy - r.rotational_energy;
@@ -75,12 +58,8 @@ TEST(HardCases, TenBallStackRestsAtTheHertzOverlap) {
   s.deck_path = "hard cases";
   s.materials = {thesis_steel(0.73)};
   const double r = 0.05;
-  WallSpec floor;
-  floor.from = {-1.0, 0.0};
-  floor.to = {1.0, 0.0};
-  floor.material = "steel";
-  s.walls = {floor};
-  for (int k = 0; k < 10; ++k) s.particles.push_back(ball(r, {0.0, r + 2.0 * r * k}));
+  s.walls = {testing_support::segment({-1.0, 0.0}, {1.0, 0.0}, "steel")};
+  for (int k = 0; k < 10; ++k) s.particles.push_back(ball("steel", r, {0.0, r + 2.0 * r * k}));
   s.run.duration = 0.6;
   Simulation sim(s);
   sim.run_until(0.6);
@@ -117,7 +96,8 @@ TEST(HardCases, BallInTheShellLifterCornerStaysInTheDrum) {
   // Touching the shell, just ahead of the lifter in the direction of turn.
   const double r = 0.1, radius = 2.5;
   const double a = -std::numbers::pi / 2.0 + (0.05 + r + 1e-4) / radius;
-  s.particles = {ball(r, {(radius - r - 1e-4) * std::cos(a), (radius - r - 1e-4) * std::sin(a)})};
+  s.particles = {
+      ball("steel", r, {(radius - r - 1e-4) * std::cos(a), (radius - r - 1e-4) * std::sin(a)})};
   Simulation sim(s);
   double max_overlap = 0.0, farthest = 0.0;
   while (sim.time() < 2.0) {
@@ -177,23 +157,6 @@ TEST(HardCases, PilesAtLowAndHighRestitutionSettleInTheBox) {
       EXPECT_LT(std::abs(r.residual), e < 0.5 ? 1e-3 : 5e-3) << "e = " << e;
     }
   }
-}
-
-// A drum scene run to t_end: the largest overlap of any step (of the smaller radius) and the
-// balance residual over the drive work.
-struct DrumRun {
-  double max_overlap = 0.0, residual = 0.0;
-};
-DrumRun run_drum(Simulation& sim, double t_end) {
-  const double b0 = energy_balance(sim.diagnostics());
-  DrumRun out;
-  while (sim.time() + 0.5 * sim.dt() < t_end) {
-    sim.step();
-    out.max_overlap = std::max(out.max_overlap, sim.last_totals().max_overlap);
-  }
-  const SeriesRow r = sim.diagnostics();
-  out.residual = (energy_balance(r) - b0) / r.drive_work;
-  return out;
 }
 
 // 20 000 steel balls (r = 1 cm) filled into the bottom of the thesis drum (16 sides) when it is

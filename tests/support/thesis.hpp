@@ -6,6 +6,7 @@
 
 #include "core/diagnostics.hpp"
 #include "core/scene.hpp"
+#include "support/scenes.hpp"
 
 namespace dem2d::testing_support {
 
@@ -49,16 +50,9 @@ inline Scene thesis_drum_scene(int balls, double speed, int sides, double ramp_t
 // An open box of three `material` wall segments: the floor from (-half_width, 0) to
 // (half_width, 0) and two sides up to `height`.
 inline void add_open_box(Scene& s, double half_width, double height, const std::string& material) {
-  const Vec2 corners[3][2] = {{{-half_width, 0.0}, {half_width, 0.0}},
-                              {{-half_width, 0.0}, {-half_width, height}},
-                              {{half_width, 0.0}, {half_width, height}}};
-  for (const auto& c : corners) {
-    WallSpec w;
-    w.from = c[0];
-    w.to = c[1];
-    w.material = material;
-    s.walls.push_back(w);
-  }
+  s.walls.push_back(segment({-half_width, 0.0}, {half_width, 0.0}, material));
+  s.walls.push_back(segment({-half_width, 0.0}, {-half_width, height}, material));
+  s.walls.push_back(segment({half_width, 0.0}, {half_width, height}, material));
 }
 
 // `count` particles of `material`, radii uniform in [r_min, r_max], placed in a box.
@@ -113,10 +107,8 @@ inline void add_pushed_lattice(Scene& s, int side, double radius, unsigned seed)
   std::uniform_real_distribution<double> push(-0.05, 0.05);
   for (int row = 0; row < side; ++row)
     for (int col = 0; col < side; ++col) {
-      ParticleSpec b;
-      b.material = "steel";
-      b.radius = radius;
-      b.position = {(col - 0.5 * (side - 1)) * pitch, (row - 0.5 * (side - 1)) * pitch};
+      ParticleSpec b = ball("steel", radius,
+                            {(col - 0.5 * (side - 1)) * pitch, (row - 0.5 * (side - 1)) * pitch});
       b.velocity = {push(draw), push(draw)};
       b.spin = 10.0 * push(draw);
       s.particles.push_back(b);
