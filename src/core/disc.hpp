@@ -17,7 +17,6 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/simd.hpp"
 #include "core/vec2.hpp"
 #include "core/walls.hpp"
 
@@ -58,7 +57,8 @@ struct Disc {
   // Two discs, centres d = x_j - x_i apart (dist2 = |d|^2), radii ri and rj.
   template <class T>
   [[gnu::always_inline]] static PairContactT<T> pair(T dx, T dy, T dist2, T ri, T rj) {
-    const T dist = vsqrt(dist2);
+    using std::sqrt;  // a pack's sqrt is found beside its type (std::experimental)
+    const T dist = sqrt(dist2);
     const T inv = 1.0 / dist;
     const T rsum = ri + rj;
     return {rsum - dist, inv * dx, inv * dy, ri * rj / rsum, ri, rj};

@@ -49,27 +49,46 @@ double accelerations(ParticleStore& p, Vec2 gravity) {
 // Velocity Verlet
 
 StepOutcome VelocityVerlet::step(StepStages& s) {
+  open_step(s);
+  s.advance_clock();
+  const bool rebuilt = lists_or_ghosts(s);
+  s.contact_forces(dt_, /*owned_cleared=*/true);
+  return close_step(s, rebuilt);
+}
+
+// v += a dt/2, x += v dt, accumulators cleared: done by the last step's closing pass when it ran
+// ahead. The owned elastic forces are zero from the last closing kick on, but not after the
+// set-up's or a population change's evaluation.
+void VelocityVerlet::open_step(StepStages& s) {
   ParticleStore& p = s.particles();
-  if (!elastic_cleared_) {  // the closing kick clears it after use; the set-up's forces did not
+  if (!elastic_cleared_) {
     std::fill(p.elastic_force.data(), p.elastic_force.data() + p.n_owned(), Vec2{});
     elastic_cleared_ = true;
   }
-  // v += a dt/2, x += v dt; accumulators cleared (done by the last step when it ran ahead)
   if (!ahead_) kick_drift_owned(p, dt_, s.drift_mirror());
   ahead_ = false;
-  s.advance_clock();
-  const bool rebuilds = rebuild_next_;  // decided in the previous step's round
-  if (rebuilds)
+}
+
+// New neighbour lists when the last step's round decided so (true), else the ghosts' state from
+// their owners, unless that round already handed it over.
+bool VelocityVerlet::lists_or_ghosts(StepStages& s) {
+  const bool rebuild = rebuild_next_;
+  if (rebuild)
     s.rebuild();
   else if (!ghosts_ahead_)
     s.refresh_ghosts();
   ghosts_ahead_ = false;
-  s.contact_forces(dt_, /*owned_cleared=*/true);
+  return rebuild;
+}
+
+// v += a dt/2, and when allowed the next step's kick-drift in the same pass (not after a rebuild:
+// the simulation keeps a backup of the state then; nor before a population change); the commit
+// and the step's round.
+StepOutcome VelocityVerlet::close_step(StepStages& s, bool rebuilt) {
+  ParticleStore& p = s.particles();
   const bool population_changes = s.population_changes();
-  // v += a dt/2, and when allowed the next step's kick-drift in the same pass. Not after a
-  // rebuild (the simulation keeps a backup of the state then), nor before a population change.
   const Vec2* x_build = s.rebuilds().positions_at_build();
-  ahead_ = run_ahead_allowed_ && !rebuilds && !population_changes;
+  ahead_ = run_ahead_allowed_ && !rebuilt && !population_changes;
   const ClosingKick closing = ahead_
                                   ? closing_kick_drift(p, x_build, dt_, gravity_, s.drift_mirror())
                                   : closing_kick(p, x_build, dt_, gravity_);

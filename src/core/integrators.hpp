@@ -231,6 +231,11 @@ class VelocityVerlet final : public Integrator {
   void state_replaced() override { after_population_change(); }
 
  private:
+  // The three stages of step(): the opening half kick and drift; the neighbour lists or the
+  // ghosts (true: rebuilt); after the forces, the closing half kick, commit and round.
+  void open_step(StepStages& s);
+  bool lists_or_ghosts(StepStages& s);
+  StepOutcome close_step(StepStages& s, bool rebuilt);
   void prepare_ghosts_ahead(const ParticleStore& p, std::span<const std::int32_t> sources);
   // The round: `max_overlap` the step's (totals()), and the rebuild decided for the next step.
   StepOutcome end_of_step_round(StepStages& s, const ClosingKick& c, double max_overlap);
