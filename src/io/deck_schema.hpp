@@ -1,8 +1,9 @@
 // The deck's description: every key of every table written once, with its type, unit, allowed
 // range, default, documentation line and the Scene field it fills. Everything else about a key
 // comes from its entry here:
-//   - the reader (deck.cpp) checks each key's type, range and presence, names the valid keys
-//     for "unknown key ...; did you mean", and stores the value through `field`;
+//   - the reader (deck.cpp, its TableReader in deck_reader.cpp) checks each key's type, range
+//     and presence, names the valid keys for "unknown key ...; did you mean", and stores the
+//     value through `field`;
 //   - the resolved deck (deck_resolved.cpp, also in run.json) writes each key back through
 //     `field`, in this order;
 //   - the key tables of docs/input.md are generated from it (key_tables(); the test

@@ -1,8 +1,8 @@
+// SnapshotWriter: the HDF5 side of the snapshots (snapshots.hpp), its transactions on
+// snapshots.h5; the sidecar snapshots.xmf is xdmf.cpp's, told here which snapshots there are.
 #include "io/snapshots.hpp"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -18,131 +18,30 @@
 
 #include "core/errors.hpp"
 #include "io/output_dir.hpp"
+#include "io/snapshot_layout.hpp"
+#include "io/xdmf.hpp"
 
 namespace dem2d {
 namespace {
 
 namespace fs = std::filesystem;
+using snapshot_layout::kGeometry;
+using snapshot_layout::kMaterial;
+using snapshot_layout::kSnapshotsGroup;
+using snapshot_layout::kWallsGroup;
+using snapshot_layout::kXdmfGroup;
+using snapshot_layout::material_lookup;
+using snapshot_layout::polyvertex_dataset;
 
-// The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
-constexpr const char* kGeometry = "position";
-// The registry field of material rows: its datasets carry the material names (attribute names).
-constexpr const char* kMaterial = "material";
 // The derived dataset every snapshot holds after the registry's: |velocity|.
 const SnapshotDataset kSpeed{"speed", "double", 1, "m/s",
                              "speed of the centre, the norm of velocity"};
 
-// The groups of snapshots.h5: complete snapshots, their wall outlines, the one being written,
-// the XDMF helpers.
-const std::string kSnapshotsGroup = "/snapshots";
-const std::string kWallsGroup = "/walls";
+// The group of the snapshot being written (snapshots.h5's other groups: snapshot_layout.hpp).
 const std::string kStagingGroup = "/incomplete";
-const std::string kXdmfGroup = "/xdmf";
 
 // Where snapshot NAME's wall outline is staged (beside its particles, /incomplete/NAME).
 std::string staged_walls(const std::string& name) { return kStagingGroup + "/walls_" + name; }
-
-// snapshots.xmf is xdmf_header(), one grid per snapshot (xdmf_grid), kXdmfTrailer.
-constexpr std::string_view kXdmfTrailer =
-    "    </Grid>\n"
-    "  </Domain>\n"
-    "</Xdmf>\n";
-
-// `text` with the five XML special characters escaped, for an attribute value.
-std::string xml_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-// "0=steel,1=iron ore": each material's row of /materials and its name.
-std::string material_lookup(const std::vector<std::string>& names) {
-  std::string out;
-  for (std::size_t k = 0; k < names.size(); ++k)
-    out += fmt::format("{}{}={}", k == 0 ? "" : ",", k, names[k]);
-  return out;
-}
-
-std::string xdmf_header(const std::vector<std::string>& material_names) {
-  std::string text =
-      "<?xml version=\"1.0\" ?>\n"
-      "<Xdmf Version=\"3.0\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n"
-      "  <Domain>\n";
-  if (!material_names.empty())
-    text += fmt::format("    <Information Name=\"material_names\" Value=\"{}\"/>\n",
-                        xml_escape(material_lookup(material_names)));
-  return text + "    <Grid Name=\"mill\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
-}
-
-// XDMF's NumberType and Precision of a SnapshotDataset::type.
-std::pair<const char*, int> xdmf_number(const std::string& type) {
-  if (type == "int64") return {"Int", 8};
-  if (type == "int32") return {"Int", 4};
-  return {"Float", 8};
-}
-
-// One XDMF DataItem that reads a whole dataset of snapshots.h5.
-std::string hdf_item(const std::string& h5_name, const std::string& dataset, std::uint64_t rows,
-                     int columns, const char* number_type, int precision) {
-  const std::string dims =
-      columns == 1 ? fmt::format("{}", rows) : fmt::format("{} {}", rows, columns);
-  return fmt::format(
-      R"(<DataItem Dimensions="{}" NumberType="{}" Precision="{}" Format="HDF">{}:{}</DataItem>)",
-      dims, number_type, precision, h5_name, dataset);
-}
-
-// An attribute of the points: "Scalar" (N values) or "Vector" (N x 2 values). A 2-component
-// vector is valid XDMF; ParaView's "XDMF Reader" pads it to 3 components (z = 0), its
-// "Xdmf3 Reader S/T" keep 2 components.
-std::string point_attribute(const std::string& attribute, const std::string& h5_name,
-                            const std::string& dataset, std::uint64_t rows, int columns,
-                            const char* number_type, int precision) {
-  return fmt::format(
-      "          <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n"
-      "            {}\n"
-      "          </Attribute>\n",
-      attribute, columns == 1 ? "Scalar" : "Vector",
-      hdf_item(h5_name, dataset, rows, columns, number_type, precision));
-}
-
-// The material names as field data (Center="Grid", one value in the file itself): ParaView
-// lists an array "material: NAME" holding the material's row, in its Information panel and
-// spreadsheet view, with every XDMF reader (none reads strings into field data).
-std::string material_attributes(const std::vector<std::string>& material_names) {
-  std::string text;
-  for (std::size_t k = 0; k < material_names.size(); ++k)
-    text += fmt::format(
-        "          <Attribute Name=\"{}: {}\" AttributeType=\"Scalar\" Center=\"Grid\">\n"
-        "            <DataItem Dimensions=\"1\" NumberType=\"Int\" Precision=\"4\" "
-        "Format=\"XML\">{}</DataItem>\n"
-        "          </Attribute>\n",
-        kMaterial, xml_escape(material_names[k]), k);
-  return text;
-}
-
-// The dataset holding 0, 1, ..., n - 1: the connectivity of a Polyvertex topology of n points.
-// The Xdmf3 readers make no cells without it (the points would not show as a surface).
-std::string polyvertex_dataset(std::uint64_t n) { return fmt::format("/xdmf/polyvertex_{}", n); }
 
 // The n of a member "polyvertex_n" of /xdmf; std::nullopt for another name.
 std::optional<std::uint64_t> polyvertex_size(const std::string& member) {
@@ -158,82 +57,6 @@ std::optional<std::uint64_t> snapshot_index(const std::string& name) {
   if (name.empty() || name.size() > 18 || name.find_first_not_of("0123456789") != std::string::npos)
     return std::nullopt;
   return std::stoull(name);
-}
-
-// The particles of one snapshot: a Polyvertex grid, position as the XY geometry, every other
-// dataset as a point attribute, the material names as field data.
-std::string particles_grid(const std::string& h5, const SnapshotInfo& r,
-                           const std::vector<std::string>& material_names) {
-  const std::string g = kSnapshotsGroup + "/" + r.name;
-  const std::uint64_t n = r.particles;
-  const std::string topology =
-      n == 0
-          ? "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"0\" NodesPerElement=\"1\"/>"
-          : fmt::format(
-                "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"{}\" "
-                "NodesPerElement=\"1\">\n            {}\n          </Topology>",
-                n, hdf_item(h5, polyvertex_dataset(n), n, 1, "Int", 8));
-  std::string text = fmt::format(
-      "        <Grid Name=\"particles\" GridType=\"Uniform\">\n"
-      "          {}\n"
-      "          <Geometry GeometryType=\"XY\">\n"
-      "            {}\n"
-      "          </Geometry>\n",
-      topology, hdf_item(h5, g + "/" + kGeometry, n, 2, "Float", 8));
-  for (const SnapshotDataset& d : r.datasets) {
-    if (d.name == kGeometry) continue;
-    const auto [number_type, precision] = xdmf_number(d.type);
-    text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
-                            number_type, precision);
-  }
-  return text + material_attributes(material_names) + "        </Grid>\n";
-}
-
-// The wall outline of one snapshot: line segments (a Polyline topology of 2 nodes per element,
-// the connectivity /walls/NNNNNN/segments) between the XY points /walls/NNNNNN/points.
-std::string walls_grid(const std::string& h5, const SnapshotInfo& r) {
-  const std::string g = kWallsGroup + "/" + r.name;
-  return fmt::format(
-      "        <Grid Name=\"walls\" GridType=\"Uniform\">\n"
-      "          <Topology TopologyType=\"Polyline\" NumberOfElements=\"{}\" "
-      "NodesPerElement=\"2\">\n"
-      "            {}\n"
-      "          </Topology>\n"
-      "          <Geometry GeometryType=\"XY\">\n"
-      "            {}\n"
-      "          </Geometry>\n"
-      "        </Grid>\n",
-      r.wall_segments, hdf_item(h5, g + "/segments", r.wall_segments, 2, "Int", 8),
-      hdf_item(h5, g + "/points", r.wall_points, 2, "Float", 8));
-}
-
-// The <Grid> of one snapshot in snapshots.xmf, a spatial collection at the snapshot's time of
-// the particles and (when the snapshot has one) the wall outline; `h5` is the HDF5 file's name.
-// ParaView's three XDMF readers show it as a multiblock of two blocks per time step.
-std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
-                      const std::vector<std::string>& material_names) {
-  std::string text = fmt::format(
-      "      <Grid Name=\"snapshot_{}\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
-      "        <Time Value=\"{:.17g}\"/>\n",
-      r.name, r.time);
-  text += particles_grid(h5, r, material_names);
-  if (r.wall_segments > 0) text += walls_grid(h5, r);
-  return text + "      </Grid>\n";
-}
-
-// Writes all of `text` at `offset` of the open file `fd`; false (errno set) on failure.
-bool write_at(int fd, std::string_view text, off_t offset) {
-  while (!text.empty()) {
-    const ssize_t n = ::pwrite(fd, text.data(), text.size(), offset);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      if (n == 0) errno = EIO;
-      return false;
-    }
-    text.remove_prefix(static_cast<std::size_t>(n));
-    offset += n;
-  }
-  return true;
 }
 
 }  // namespace
@@ -257,7 +80,8 @@ SnapshotWriter::SnapshotWriter(NoFile, MPI_Comm comm, const std::string& directo
     : comm_(comm),
       rank_(mpi::rank(comm)),
       h5_path_((fs::path(directory) / kSnapshotsFile).string()),
-      xdmf_path_((fs::path(directory) / kXdmfFile).string()) {}
+      xdmf_(std::make_unique<XdmfSidecar>((fs::path(directory) / kXdmfFile).string(),
+                                          fs::path(h5_path_).filename().string())) {}
 
 SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
                                const std::vector<MaterialSpec>& materials)
@@ -272,7 +96,7 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
     } else {
       std::fclose(probe);
       std::error_code ec;
-      fs::remove(xdmf_path_, ec);  // a stale sidecar would point at groups no longer there
+      fs::remove(xdmf_->path(), ec);  // a stale sidecar would point at groups no longer there
     }
   }
   mpi::agree_on_failure<IoError>(comm_, error);
@@ -311,13 +135,15 @@ std::unique_ptr<SnapshotWriter> SnapshotWriter::resume(MPI_Comm comm, const std:
     error = e.what();
   }
   w->agree(error);
-  if (w->rank_ == 0) error = w->rewrite_xdmf();
+  if (w->rank_ == 0) error = w->xdmf_->rewrite(w->records_, w->material_names_);
   w->agree(error);
   return w;
 }
 
 // Closes the file through the handle's destructor, which ignores (cannot report) a failure.
 SnapshotWriter::~SnapshotWriter() = default;
+
+const std::string& SnapshotWriter::xdmf_path() const { return xdmf_->path(); }
 
 void SnapshotWriter::write_materials(const std::vector<MaterialSpec>& materials) {
   file_->create_group("/materials");
@@ -424,7 +250,7 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
   records_.push_back(std::move(record));
   ++next_index_;
-  if (rank_ == 0) error = append_xdmf(records_.back());
+  if (rank_ == 0) error = xdmf_->append(records_, material_names_);
   agree(error);
 }
 
@@ -656,46 +482,6 @@ void SnapshotWriter::close() {
   }
   file_.reset();
   mpi::agree_on_failure<IoError>(comm_, error);
-}
-
-std::string SnapshotWriter::rewrite_xdmf() {
-  xmf_trailer_.reset();
-  if (records_.empty()) {  // nothing to show
-    std::error_code ec;
-    fs::remove(xdmf_path_, ec);
-    return ec ? fmt::format("cannot remove {}: {}", xdmf_path_, ec.message()) : std::string();
-  }
-  const std::string h5 = fs::path(h5_path_).filename().string();
-  std::string text = xdmf_header(material_names_);
-  for (const SnapshotInfo& r : records_) text += xdmf_grid(h5, r, material_names_);
-  const auto trailer_at = static_cast<long>(text.size());
-  text += kXdmfTrailer;
-  std::string error = write_file_atomically(xdmf_path_, text);
-  if (error.empty()) xmf_trailer_ = trailer_at;
-  return error;
-}
-
-// O(1): the new grid and the trailer over the old trailer. On a failure the old trailer is put
-// back and the file cut after it (best effort), and the next snapshot rewrites the file whole.
-std::string SnapshotWriter::append_xdmf(const SnapshotInfo& record) {
-  if (!xmf_trailer_) return rewrite_xdmf();  // the first snapshot, or after a failure
-  const int fd = ::open(xdmf_path_.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0) return rewrite_xdmf();  // removed meanwhile: made anew
-  const auto at = static_cast<off_t>(*xmf_trailer_);
-  xmf_trailer_.reset();  // until the write succeeded
-  const std::string grid =
-      xdmf_grid(fs::path(h5_path_).filename().string(), record, material_names_);
-  bool ok = write_at(fd, grid + std::string(kXdmfTrailer), at);
-  int error = errno;
-  if (!ok && write_at(fd, kXdmfTrailer, at))
-    (void)!::ftruncate(fd, at + static_cast<off_t>(kXdmfTrailer.size()));
-  if (::close(fd) != 0 && ok) {
-    ok = false;
-    error = errno;
-  }
-  if (!ok) return fmt::format("cannot write {}: {}", xdmf_path_, std::strerror(error));
-  xmf_trailer_ = static_cast<long>(at) + static_cast<long>(grid.size());
-  return {};
 }
 
 }  // namespace dem2d

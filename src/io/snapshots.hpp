@@ -43,7 +43,8 @@
 // snapshot (through a temporary file and a rename); each later snapshot costs O(1): its <Grid>
 // and the fixed closing trailer (</Grid></Domain></Xdmf>) overwrite the old trailer in place,
 // so the file is a valid XDMF document at every moment but during that one small write.
-// resume() regenerates it whole (temporary file and rename).
+// resume() regenerates it whole (temporary file and rename). The .xmf text and file are
+// xdmf.hpp's (XdmfSidecar); the names both files use, snapshot_layout.hpp's.
 //
 // Every member is collective over the communicator. A failure throws IoError with the same
 // message on every rank.
@@ -65,6 +66,8 @@
 #include "parallel/comm.hpp"
 
 namespace dem2d {
+
+class XdmfSidecar;  // xdmf.hpp
 
 // A per-particle field that is not in the store's registry, written after the registry's:
 // one value per owned particle, in the store's order. Names must be the same on all ranks and
@@ -143,7 +146,7 @@ class SnapshotWriter {
   void close();
 
   const std::string& h5_path() const { return h5_path_; }
-  const std::string& xdmf_path() const { return xdmf_path_; }
+  const std::string& xdmf_path() const;
   // The snapshots under /snapshots, in order: those written, after those a resume kept.
   const std::vector<SnapshotInfo>& snapshots() const { return records_; }
   std::size_t snapshots_written() const { return records_.size(); }
@@ -176,14 +179,11 @@ class SnapshotWriter {
   std::optional<SnapshotInfo> read_record(const std::string& name, double last_time);
   void reconcile_polyvertex();
   void reconcile_walls();
-  // Rank 0; each returns an error message, empty on success.
-  std::string rewrite_xdmf();                           // the whole file, atomically
-  std::string append_xdmf(const SnapshotInfo& record);  // in place, O(1)
 
   MPI_Comm comm_;
   int rank_ = 0;
   std::string h5_path_;
-  std::string xdmf_path_;
+  std::unique_ptr<XdmfSidecar> xdmf_;  // snapshots.xmf, kept by rank 0 (xdmf.hpp)
   std::optional<h5::ParallelFile> file_;
   std::vector<std::string> material_names_;  // /materials/name: snapshots.xmf names them
   std::vector<SnapshotInfo> records_;
@@ -191,7 +191,6 @@ class SnapshotWriter {
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
   bool failed_ = false;                       // the last write failed: clear its remains first
   std::optional<std::size_t> fail_before_dataset_;  // fail_before_dataset_for_testing
-  std::optional<long> xmf_trailer_;  // rank 0: offset of the trailer in snapshots.xmf, if valid
 };
 
 }  // namespace dem2d

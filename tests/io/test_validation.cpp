@@ -1,5 +1,5 @@
 // Checks before step 1 (docs/input.md, "Checks before the run"): the placement of file rows and
-// lifters (src/io/deck.cpp), the first step's motion, the step count and the memory estimate
+// lifters (src/io/placement.cpp), the first step's motion, the step count and the memory estimate
 // (src/core/validate.*), each refused with its location, key and limit.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -115,7 +115,7 @@ std::string particle(const std::string& position, double radius = 0.1,
 }
 
 // ---------------------------------------------------------------------------------------------
-// Placement of file rows and lifters (deck.cpp)
+// Placement of file rows and lifters (placement.cpp)
 
 // The rows of a [[fill]] file are placed like [[particle]] tables: a row outside the drum,
 // overlapping the shell by more than 5 % of its radius, coinciding with a [[particle]] or
@@ -222,8 +222,8 @@ TEST(Validation, CsvRowsKeepClearOfLifters) {
                              "the drum's initial angle); place it clear of the lifters");
 }
 
-// One tolerance for pairs, the shell and the bars (deck.cpp, Placement::kPlacementOverlap): a row
-// overlapping the shell or a bar by 0.4 % of its radius passes, one overlapping it by 10 % is
+// One tolerance for pairs, the shell and the bars (placement.hpp, Placement::kPlacementOverlap): a
+// row overlapping the shell or a bar by 0.4 % of its radius passes, one overlapping it by 10 % is
 // refused at its CSV line with the overlap and the 5 % allowed.
 TEST(Validation, ShellAndBarsTakeTheOverlapAllowedBetweenParticles) {
   const TempDir dir;

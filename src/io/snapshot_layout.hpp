@@ -1,0 +1,40 @@
+// The names in snapshots.h5 (the layout snapshots.hpp describes) that both of its writers use:
+// the HDF5 side (snapshots.cpp) writes the groups and datasets, the XDMF sidecar (xdmf.cpp)
+// points at them. Internal to the snapshot writer.
+#pragma once
+
+#include <fmt/format.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dem2d::snapshot_layout {
+
+// The groups of snapshots.h5: complete snapshots, their wall outlines, the XDMF helpers.
+inline const std::string kSnapshotsGroup = "/snapshots";
+inline const std::string kWallsGroup = "/walls";
+inline const std::string kXdmfGroup = "/xdmf";
+
+// The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
+inline constexpr const char* kGeometry = "position";
+// The registry field of material rows: its datasets carry the material names (attribute names).
+inline constexpr const char* kMaterial = "material";
+
+// The dataset holding 0, 1, ..., n - 1: the connectivity of a Polyvertex topology of n points.
+// The Xdmf3 readers make no cells without it (the points would not show as a surface).
+inline std::string polyvertex_dataset(std::uint64_t n) {
+  return fmt::format("/xdmf/polyvertex_{}", n);
+}
+
+// "0=steel,1=iron ore": each material's row of /materials and its name (the `names` attribute
+// of a snapshot's material dataset; the XDMF domain's material_names).
+inline std::string material_lookup(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t k = 0; k < names.size(); ++k)
+    out += fmt::format("{}{}={}", k == 0 ? "" : ",", k, names[k]);
+  return out;
+}
+
+}  // namespace dem2d::snapshot_layout
