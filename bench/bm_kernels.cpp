@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 #include "settled_drum.hpp"
 
 namespace {

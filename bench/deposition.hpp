@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/vec2.hpp"
+#include "core/base/vec2.hpp"
 
 namespace bench {
 

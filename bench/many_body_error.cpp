@@ -48,8 +48,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/step/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

@@ -60,7 +60,7 @@
 #include <string>
 #include <vector>
 
-#include "core/vec2.hpp"
+#include "core/base/vec2.hpp"
 #include "parallel/sector_partition.hpp"
 #include "settled_drum.hpp"
 

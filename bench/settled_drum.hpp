@@ -91,8 +91,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/scene.hpp"
-#include "core/simulation.hpp"
+#include "core/base/scene.hpp"
+#include "core/step/simulation.hpp"
 #include "deposition.hpp"
 
 namespace bench {

@@ -1,6 +1,7 @@
 // steps_per_contact: the restitution error against the number of steps per Hertz contact, for
 // both integrators: the measurement behind dt = "auto"'s rule
-// N(e) = max(20, 50 (-ln e / ln 2)^1.77) (src/core/time_scales.hpp, docs/models.md "Why N(e)").
+// N(e) = max(20, 50 (-ln e / ln 2)^1.77) (src/core/step/time_scales.hpp, docs/models.md "Why
+// N(e)").
 //
 // Two thesis-steel balls (r = 0.1 m, E = 2e11 Pa, nu = 0.25, hertz-mindlin, no friction effect:
 // head-on) meet at 2 x 20 m/s. dt = t_c / N with t_c = 2.868 (m*^2 / (E*^2 R* v))^(1/5), the
@@ -20,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.hpp"
-#include "core/time_scales.hpp"
+#include "core/step/simulation.hpp"
+#include "core/step/time_scales.hpp"
 #include "settled_drum.hpp"
 
 namespace dem2d {

@@ -35,7 +35,7 @@
 //            --repeats segments of --block-time s (2.5 s) timed; contacts and candidate pairs
 //            per particle are the means of samples every 10 ms of the timed segments. Target of
 //            target: 40 million particle-steps/s.
-// order      Storage order (run.spatial_sort, core/spatial_order.hpp): the drum packings of
+// order      Storage order (run.spatial_sort, core/fast/spatial_order.hpp): the drum packings of
 //            --order-particles (default 1e5, 1e6) with their ids as the fill gave them (row by
 //            row: spatially coherent) and shuffled (a fixed random permutation: ids spatially
 //            random, as in a long-mixed charge or after grinding), each with the store kept in
@@ -98,8 +98,8 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/step/simulation.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "settled_drum.hpp"
@@ -703,8 +703,7 @@ void ratio_section(const Options& opt, std::vector<Row>& rows) {
       std::printf(
           "(r) size ratio %g: %.1f ns per particle-step = %.2f x the monodisperse %.1f "
           "ns%s\n",
-          r.ratio, r.ns_cpu(), r.cost_vs_mono, base,
-          r.ratio == 10.0 ? " (bound: <= 1.5 x)" : "");
+          r.ratio, r.ns_cpu(), r.cost_vs_mono, base, r.ratio == 10.0 ? " (bound: <= 1.5 x)" : "");
   }
   rows.insert(rows.end(), rat.begin(), rat.end());
 }

@@ -58,10 +58,10 @@
 #include <string>
 #include <vector>
 
-#include "core/disc.hpp"
-#include "core/errors.hpp"
-#include "core/particles.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/shape/disc.hpp"
+#include "core/shape/particles.hpp"
+#include "core/step/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace {

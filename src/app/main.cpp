@@ -1,5 +1,6 @@
-// dem2d: command line, wiring and exit codes (docs/architecture.md, "Command line and exit status"). Everything else lives in the
-// libraries: the deck and outputs in src/io, the physics in src/core, MPI in src/parallel.
+// dem2d: command line, wiring and exit codes (docs/architecture.md, "Command line and exit
+// status"). Everything else lives in the libraries: the deck and outputs in src/io, the physics in
+// src/core, MPI in src/parallel.
 //
 // Exit status: 0 success, 2 bad input or usage, 3 the run became unstable, 4 an I/O failure,
 // 5 interrupted by SIGINT or SIGTERM (a checkpoint to resume from was written).
@@ -15,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/step/simulation.hpp"
 #include "io/check_report.hpp"
 #include "io/checkpoint.hpp"
 #include "io/console.hpp"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/mill_analytics.hpp"
+#include "core/mill/mill_analytics.hpp"
 #include "io/text.hpp"
 
 namespace dem2d {

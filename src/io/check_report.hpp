@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 
 namespace dem2d {
 

@@ -10,7 +10,7 @@
 #include <map>
 #include <sstream>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/deck.hpp"
 #include "io/hdf5.hpp"
 #include "io/output_dir.hpp"

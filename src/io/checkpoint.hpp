@@ -17,15 +17,15 @@
 //                     ones: accelerations, forces, inverse masses, damage...), N rows (N x 2
 //                     for a vector), rank 0's particles first
 //   /contacts/a, /contacts/b, /contacts/history  the committed contact histories keyed by
-//                     particle ids (core/contact_history.hpp), M rows (M x width); a pair that
-//                     spans two ranks appears once per rank
+//                     particle ids (core/contact/contact_history.hpp), M rows (M x width); a pair
+//                     that spans two ranks appears once per rank
 // It is written to checkpoint.h5.tmp and renamed over checkpoint.h5 once closed: a run killed
 // during the write keeps the previous checkpoint whole.
 #pragma once
 
 #include <string>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 #include "parallel/comm.hpp"
 
 namespace dem2d {

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <limits>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/output_dir.hpp"
 #include "parallel/comm.hpp"
 

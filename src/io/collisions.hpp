@@ -1,5 +1,5 @@
 // collisions.csv: the collision energy spectra of a run with output.collision_spectra = true
-// (core/mill_analytics.hpp, CollisionSpectra; docs/output.md). One row per non-empty bin:
+// (core/mill/mill_analytics.hpp, CollisionSpectra; docs/output.md). One row per non-empty bin:
 //   type        ball-ball, ball-ore, ore-ore, ball-shell, ball-lifter, ball-wall, ore-shell,
 //               ore-lifter, ore-wall
 //   size_min, size_max   m, the size class: the smaller particle's diameter (size_max inf for
@@ -16,7 +16,7 @@
 
 #include <string>
 
-#include "core/mill_analytics.hpp"
+#include "core/mill/mill_analytics.hpp"
 
 namespace dem2d {
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 
 namespace dem2d {
 

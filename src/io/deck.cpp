@@ -26,8 +26,8 @@
 #include <string_view>
 #include <utility>
 
-#include "core/drum_geometry.hpp"
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
+#include "core/geometry/drum_geometry.hpp"
 #include "io/deck_diagnostics.hpp"
 #include "io/deck_reader.hpp"
 #include "io/deck_schema.hpp"

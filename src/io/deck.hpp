@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
 
 namespace dem2d {
 

@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/vec2.hpp"
+#include "core/base/vec2.hpp"
 #include "io/deck_diagnostics.hpp"
 #include "io/deck_schema.hpp"
 

@@ -10,7 +10,7 @@
 //     DeckDocs.KeyTablesMatchTheDescription names the key where the docs differ);
 //   - tests/io/test_deck.cpp compares two scenes key by key through it.
 // Defaults are not written here: a key's default is its Scene field's initial value
-// (core/scene.hpp), which the docs show. Rules between keys (speed / speed_rpm /
+// (core/base/scene.hpp), which the docs show. Rules between keys (speed / speed_rpm /
 // critical_fraction, count / fill_fraction / file, poisson_ratio / shear_modulus, ...) are code
 // in deck.cpp that runs after the per-key pass.
 //
@@ -31,7 +31,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
 #include "io/deck.hpp"  // kRadiansPerDegree, kRadPerSecondPerRpm
 
 namespace dem2d::deck {

@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <type_traits>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "parallel/comm.hpp"
 
 namespace dem2d::h5 {

@@ -24,8 +24,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/particles.hpp"  // FieldBase: particle fields as datasets (field_column)
-#include "parallel/comm.hpp"   // MPI_Comm: the MPI-IO driver takes the communicator
+#include "core/shape/particles.hpp"  // FieldBase: particle fields as datasets (field_column)
+#include "parallel/comm.hpp"         // MPI_Comm: the MPI-IO driver takes the communicator
 
 namespace dem2d::h5 {
 

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/grinding.hpp"
+#include "core/mill/grinding.hpp"
 
 namespace dem2d {
 

@@ -14,7 +14,7 @@
 #include <system_error>
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "parallel/comm.hpp"
 
 namespace dem2d {

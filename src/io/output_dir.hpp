@@ -1,6 +1,6 @@
 // The output directory of a run: created, checked and claimed once, before anything is
-// written, by all ranks together (docs/architecture.md, "Code conventions"). One folder, one run: a run claims its
-// folder with a lock file naming its host and pid, removed when the run ends.
+// written, by all ranks together (docs/architecture.md, "Code conventions"). One folder, one run: a
+// run claims its folder with a lock file naming its host and pid, removed when the run ends.
 #pragma once
 
 #include <string>

@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
 
 namespace dem2d {
 

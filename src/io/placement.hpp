@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/drum_geometry.hpp"
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
+#include "core/geometry/drum_geometry.hpp"
 #include "io/deck_diagnostics.hpp"
 
 namespace dem2d::deck {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numbers>
 
-#include "core/mill_analytics.hpp"
+#include "core/mill/mill_analytics.hpp"
 #include "io/text.hpp"
 
 namespace dem2d {

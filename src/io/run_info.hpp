@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 #include "io/run_json.hpp"
 #include "parallel/mpi_domain.hpp"
 

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <string_view>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/deck.hpp"
 #include "io/text.hpp"
 

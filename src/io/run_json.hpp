@@ -10,7 +10,7 @@
 #include <utility>
 #include <vector>
 
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
 
 namespace dem2d {
 

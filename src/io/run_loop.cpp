@@ -6,7 +6,7 @@
 #include <csignal>
 #include <string>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/checkpoint.hpp"
 #include "io/collisions.hpp"
 #include "io/output_dir.hpp"

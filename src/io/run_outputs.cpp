@@ -3,7 +3,7 @@
 #include <string>
 #include <utility>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/output_dir.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/ore_records.hpp"

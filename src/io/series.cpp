@@ -11,7 +11,7 @@
 #include <iterator>
 #include <type_traits>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 
 namespace dem2d {
 

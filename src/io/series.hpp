@@ -16,7 +16,7 @@
 #include <variant>
 #include <vector>
 
-#include "core/diagnostics.hpp"
+#include "core/step/diagnostics.hpp"
 
 namespace dem2d {
 

@@ -16,7 +16,7 @@
 #include <string_view>
 #include <utility>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/output_dir.hpp"
 #include "io/snapshot_layout.hpp"
 #include "io/xdmf.hpp"

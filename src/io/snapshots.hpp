@@ -8,7 +8,7 @@
 //   /snapshots/NNNNNN                    one group per write(), NNNNNN = 000000, 000001, ...
 //       attributes time (double, s), step (int64)
 //       one dataset per particle field marked `snapshot` in the store's registry
-//       (core/particles.hpp: id, material, position, velocity, angle, spin, radius), named as
+//       (core/shape/particles.hpp: id, material, position, velocity, angle, spin, radius), named as
 //       the field, N rows (N x 2 for a Vec2), with string attributes `unit` and `doc` from the
 //       field's FieldMeta (`material` also `names`, "0=steel,1=ore"); then `speed` (|velocity|,
 //       m/s); then any extra fields. The group tracks the creation order of its datasets
@@ -59,9 +59,9 @@
 #include <string>
 #include <vector>
 
-#include "core/particles.hpp"
-#include "core/scene.hpp"
-#include "core/vec2.hpp"
+#include "core/base/scene.hpp"
+#include "core/base/vec2.hpp"
+#include "core/shape/particles.hpp"
 #include "io/hdf5.hpp"
 #include "parallel/comm.hpp"
 
@@ -133,8 +133,8 @@ class SnapshotWriter {
   SnapshotWriter& operator=(const SnapshotWriter&) = delete;
 
   // Writes the owned particles [0, n_owned()) as the next snapshot, with the wall outline
-  // `walls` (polylines in the lab frame at `time`, e.g. core/walls.hpp's wall_outlines; rank
-  // 0's are written, every rank passes the same; none: no /walls group, no "walls" grid):
+  // `walls` (polylines in the lab frame at `time`, e.g. core/geometry/walls.hpp's wall_outlines;
+  // rank 0's are written, every rank passes the same; none: no /walls group, no "walls" grid):
   // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, flush, move to /walls/NNNNNN and
   // /snapshots/NNNNNN, flush; then rank 0 appends its grid to snapshots.xmf. After a failed
   // write (IoError) the writer may write again: the next write first removes what the failed

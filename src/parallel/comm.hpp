@@ -1,9 +1,9 @@
-// Every MPI call of dem2d, as small verbs over a communicator (docs/architecture.md, "Code conventions"; CoMD's
-// parallel.c keeps all of its MPI in one file for the same reason). MpiDomain builds the
-// decomposition on these; src/io uses them for its collective decisions (row offsets of a
-// snapshot, agreeing on a failure) and takes only the MPI_Comm handle itself, which parallel
-// HDF5 needs (H5Pset_fapl_mpio); src/app calls nothing but mpi::init, MPI_Comm_rank,
-// MPI_Comm_size and MPI_Finalize (tests/structure/check_layers.sh checks both).
+// Every MPI call of dem2d, as small verbs over a communicator (docs/architecture.md, "Code
+// conventions"; CoMD's parallel.c keeps all of its MPI in one file for the same reason). MpiDomain
+// builds the decomposition on these; src/io uses them for its collective decisions (row offsets of
+// a snapshot, agreeing on a failure) and takes only the MPI_Comm handle itself, which parallel HDF5
+// needs (H5Pset_fapl_mpio); src/app calls nothing but mpi::init, MPI_Comm_rank, MPI_Comm_size and
+// MPI_Finalize (tests/structure/check_layers.sh checks both).
 //
 // Every function is collective over `comm` unless it says otherwise: all ranks call it, in
 // the same order. Reductions of doubles that feed the physics are exact (max) or added in
@@ -69,9 +69,9 @@ void exchange_bytes(MPI_Comm comm, std::span<const int> peers,
                     const std::vector<std::vector<std::byte>>& send,
                     std::vector<std::vector<std::byte>>& recv, std::vector<MPI_Request>& requests);
 
-// Agreeing on a failure (docs/architecture.md, "Code conventions": never a throw on one rank that leaves the others
-// waiting in a collective). `local_error` is this rank's failure message, empty if it
-// succeeded. Returns, on every rank, the message of the lowest failing rank, or an empty
+// Agreeing on a failure (docs/architecture.md, "Code conventions": never a throw on one rank that
+// leaves the others waiting in a collective). `local_error` is this rank's failure message, empty
+// if it succeeded. Returns, on every rank, the message of the lowest failing rank, or an empty
 // string when no rank failed.
 std::string first_failure(MPI_Comm comm, const std::string& local_error);
 

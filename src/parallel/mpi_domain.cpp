@@ -257,7 +257,7 @@ void MpiDomain::transport(const Plan& plan, const MessageLayout& layout,
 // migration (make_plan), one message per peer (the particles field by field, then their
 // records), the arrivals appended in ascending rank order and put in id order, so the store is
 // the same whatever rank a particle came from: a store in id order stays in id order; one in
-// spatial order (core/spatial_order.hpp) keeps the order of the particles that stay, with the
+// spatial order (core/fast/spatial_order.hpp) keeps the order of the particles that stay, with the
 // arrivals after them (the next sort puts them in place).
 void MpiDomain::migrate(ParticleStore& p, HistoryRecords& histories) {
   CommTimer timer(stats_.comm_seconds);

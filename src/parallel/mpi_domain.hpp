@@ -51,9 +51,9 @@
 #include <string>
 #include <vector>
 
-#include "core/domain.hpp"
-#include "core/scene.hpp"
-#include "core/vec2.hpp"
+#include "core/base/scene.hpp"
+#include "core/base/vec2.hpp"
+#include "core/step/domain.hpp"
 #include "parallel/comm.hpp"
 #include "parallel/sector_partition.hpp"
 

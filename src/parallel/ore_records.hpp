@@ -1,4 +1,4 @@
-// The ore scenes' records (breakages and discharged product, core/grinding.hpp) of every rank,
+// The ore scenes' records (breakages and discharged product, core/mill/grinding.hpp) of every rank,
 // brought together for the logs that rank 0 writes (io/ore_logs.hpp).
 #pragma once
 
@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "core/grinding.hpp"
+#include "core/mill/grinding.hpp"
 
 namespace dem2d {
 

@@ -85,7 +85,7 @@
 #include <string>
 #include <vector>
 
-#include "core/vec2.hpp"
+#include "core/base/vec2.hpp"
 
 namespace dem2d {
 

@@ -1,7 +1,7 @@
 // Pair-level checks of the contact laws in closed form (docs/models.md, "Contact laws"), first by
-// calling the law structs of core/contact_models.hpp directly, then through a small Simulation
-// (force assembly, torques, signs): the thesis's ~20 direction tests (T section 1.9) for two
-// balls, a ball and a floor, a translating wall and a rotating drum.
+// calling the law structs of core/contact/contact_models.hpp directly, then through a small
+// Simulation (force assembly, torques, signs): the thesis's ~20 direction tests (T section 1.9) for
+// two balls, a ball and a floor, a translating wall and a rotating drum.
 //
 // Conventions (docs/models.md, "Bodies and frame", "Contact kinematics"): x right, y up, every
 // angle and spin counter-clockwise positive; for a pair i < j, n points from i to j, t = perp(n) =
@@ -16,10 +16,10 @@
 #include <string>
 #include <vector>
 
-#include "core/contact_models.hpp"
-#include "core/materials.hpp"
-#include "core/scene.hpp"
-#include "core/simulation.hpp"
+#include "core/base/scene.hpp"
+#include "core/contact/contact_models.hpp"
+#include "core/contact/materials.hpp"
+#include "core/step/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
 #include "support/runs.hpp"

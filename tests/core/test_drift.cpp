@@ -1,10 +1,10 @@
-// Velocity Verlet's drift (core/integrators.hpp kick_drift_owned): with AVX-512 it moves four
+// Velocity Verlet's drift (core/step/integrators.hpp kick_drift_owned): with AVX-512 it moves four
 // particles per iteration. It must leave every field it writes, and the pair gather's mirror
 // lines, the same bit for bit as the one-at-a-time loop, for any count (whole fours and a tail).
 #include <gtest/gtest.h>
 
-#include "core/integrators.hpp"
-#include "core/kinematics_mirror.hpp"
+#include "core/fast/kinematics_mirror.hpp"
+#include "core/step/integrators.hpp"
 #include "support/random_store.hpp"
 
 namespace dem2d {

@@ -1,4 +1,4 @@
-// EightLanes (core/simd.hpp): the pair loop's energy sums are the same bits whatever the
+// EightLanes (core/fast/simd.hpp): the pair loop's energy sums are the same bits whatever the
 // build's vector width. The Release build runs this with 8-wide packs (AVX-512 here), the
 // sanitizer build (no -march=native) with 2-wide ones; both must give the eight-lane sum.
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "core/simd.hpp"
+#include "core/fast/simd.hpp"
 
 namespace dem2d {
 namespace {

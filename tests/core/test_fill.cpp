@@ -4,12 +4,12 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/contact_models.hpp"
-#include "core/disc.hpp"
-#include "core/errors.hpp"
-#include "core/fill.hpp"
-#include "core/materials.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/contact/contact_models.hpp"
+#include "core/contact/materials.hpp"
+#include "core/setup/fill.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

@@ -8,9 +8,9 @@
 #include <map>
 #include <numbers>
 
-#include "core/contact_models.hpp"
-#include "core/disc.hpp"
-#include "core/simulation.hpp"
+#include "core/contact/contact_models.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

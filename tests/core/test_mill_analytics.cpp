@@ -1,4 +1,4 @@
-// Mill analytics (core/mill_analytics.hpp) on constructed states with known answers: a bed
+// Mill analytics (core/mill/mill_analytics.hpp) on constructed states with known answers: a bed
 // resting in a circular segment tilted at a known angle, one particle on the shell, a charge
 // turning rigidly with the drum, the mirror image of a clockwise drum; the window's average
 // power against a constant drive; the collision spectra against the closed-form peak energy of
@@ -8,9 +8,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/disc.hpp"
-#include "core/mill_analytics.hpp"
-#include "core/simulation.hpp"
+#include "core/mill/mill_analytics.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

@@ -1,6 +1,6 @@
-// Neighbour search (core/neighbors.hpp): the cell-grid Verlet lists hold exactly the brute-force
-// candidate set, contact histories survive rebuilds and reordering of the particle store, and
-// during a run every actual contact is found.
+// Neighbour search (core/contact/neighbors.hpp): the cell-grid Verlet lists hold exactly the
+// brute-force candidate set, contact histories survive rebuilds and reordering of the particle
+// store, and during a run every actual contact is found.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,11 +11,11 @@
 #include <utility>
 #include <vector>
 
-#include "core/disc.hpp"
-#include "core/neighbors.hpp"
-#include "core/random.hpp"
-#include "core/simulation.hpp"
-#include "core/walls.hpp"
+#include "core/base/random.hpp"
+#include "core/contact/neighbors.hpp"
+#include "core/geometry/walls.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

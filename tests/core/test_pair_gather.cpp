@@ -1,14 +1,13 @@
-// The pair loop's two implementations of its gather (core/pair_gather.hpp): with AVX-512, eight
-// candidates at a time through a one-line mirror of the particles; else one at a time from the
-// store's columns. A run with each ends with every field of
-// every particle the same bit for bit, and the same contact count, energies and drive torque:
-// every contact law (with its history width), the iterative scheme, two materials with breakage,
-// feed and sieve, a 10:1 size range and a spatially sorted store. Without AVX-512 both runs take
-// the scalar path and the test says so.
+// The pair loop's two implementations of its gather (core/fast/pair_gather.hpp): with AVX-512,
+// eight candidates at a time through a one-line mirror of the particles; else one at a time from
+// the store's columns. A run with each ends with every field of every particle the same bit for
+// bit, and the same contact count, energies and drive torque: every contact law (with its history
+// width), the iterative scheme, two materials with breakage, feed and sieve, a 10:1 size range and
+// a spatially sorted store. Without AVX-512 both runs take the scalar path and the test says so.
 #include <gtest/gtest.h>
 
-#include "core/pair_gather.hpp"
-#include "core/simulation.hpp"
+#include "core/fast/pair_gather.hpp"
+#include "core/step/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/thesis.hpp"
 

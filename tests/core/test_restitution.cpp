@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/materials.hpp"
+#include "core/contact/materials.hpp"
 
 namespace dem2d {
 namespace {

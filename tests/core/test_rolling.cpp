@@ -11,8 +11,8 @@
 #include <numbers>
 #include <string>
 
-#include "core/scene.hpp"
-#include "core/simulation.hpp"
+#include "core/base/scene.hpp"
+#include "core/step/simulation.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

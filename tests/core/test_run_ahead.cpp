@@ -1,5 +1,5 @@
-// Velocity Verlet running ahead (core/integrators.hpp closing_kick_drift): when nothing looks at
-// the state between two steps, the closing half kick of the first and the kick-drift of the
+// Velocity Verlet running ahead (core/step/integrators.hpp closing_kick_drift): when nothing looks
+// at the state between two steps, the closing half kick of the first and the kick-drift of the
 // second are one pass over the store. That pass must leave every field, every mirror line and
 // every sum of the round bit for bit as the two passes do, and a run that runs ahead must end
 // bit for bit as the run that never does, energy ledger included. A step that fails after
@@ -12,9 +12,9 @@
 #include <string>
 #include <utility>
 
-#include "core/integrators.hpp"
-#include "core/kinematics_mirror.hpp"
-#include "core/simulation.hpp"
+#include "core/fast/kinematics_mirror.hpp"
+#include "core/step/integrators.hpp"
+#include "core/step/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
 #include "support/thesis.hpp"

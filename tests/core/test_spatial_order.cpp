@@ -1,5 +1,5 @@
-// Storage order (core/spatial_order.hpp): the Hilbert curve visits every cell once, stepping to
-// an adjacent cell each time; the sorted store is in curve order; and a run whose particles are
+// Storage order (core/fast/spatial_order.hpp): the Hilbert curve visits every cell once, stepping
+// to an adjacent cell each time; the sorted store is in curve order; and a run whose particles are
 // re-sorted at every rebuild ends with every field of every particle bit for bit as the run kept
 // in id order: Verlet and the iterative scheme, a 10:1 size range (several search levels), and
 // breakage, feed and sieve changing the population.
@@ -11,9 +11,9 @@
 #include <map>
 #include <set>
 
-#include "core/contact_kernel.hpp"
-#include "core/simulation.hpp"
-#include "core/spatial_order.hpp"
+#include "core/contact/contact_kernel.hpp"
+#include "core/fast/spatial_order.hpp"
+#include "core/step/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/thesis.hpp"
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "core/disc.hpp"
-#include "core/errors.hpp"
-#include "core/simulation.hpp"
+#include "core/base/errors.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -25,9 +25,9 @@
 #include <numbers>
 #include <vector>
 
-#include "core/disc.hpp"
-#include "core/random.hpp"
-#include "core/simulation.hpp"
+#include "core/base/random.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -1,5 +1,5 @@
-// Wall loads (core/wall_loads.hpp): one record per wall contact, in the wall list's order, at a
-// point of its element; a charge at rest in a still drum hands the walls its whole weight and
+// Wall loads (core/geometry/wall_loads.hpp): one record per wall contact, in the wall list's order,
+// at a point of its element; a charge at rest in a still drum hands the walls its whole weight and
 // its whole moment about the drum's axis (Newton's third law and the balance of moments: the pair
 // forces cancel in both sums), and the drive's torque and power are computed from the records.
 #include <gtest/gtest.h>
@@ -9,8 +9,8 @@
 #include <set>
 #include <utility>
 
-#include "core/simulation.hpp"
-#include "core/wall_loads.hpp"
+#include "core/geometry/wall_loads.hpp"
+#include "core/step/simulation.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {

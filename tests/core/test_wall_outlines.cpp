@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "core/walls.hpp"
+#include "core/geometry/walls.hpp"
 
 namespace dem2d {
 namespace {

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "core/errors.hpp"
-#include "core/particles.hpp"
-#include "core/scene.hpp"
-#include "core/time_scales.hpp"
-#include "core/validate.hpp"
+#include "core/base/errors.hpp"
+#include "core/base/scene.hpp"
+#include "core/setup/validate.hpp"
+#include "core/shape/particles.hpp"
+#include "core/step/time_scales.hpp"
 #include "io/deck.hpp"
 #include "io/particle_csv.hpp"
 

@@ -35,8 +35,8 @@ FuzzCase split_case(std::string_view data);
 
 // Reads the CSV section (if any), then the deck with its overrides; for a deck that is read
 // without error, the checks that follow without MPI and without placing the fills' particles
-// (core/validate.hpp, core/time_scales.hpp): how many particles each fill expects, the time
-// scales and dt over the deck's particles and one particle of each fill's smallest radius, the
+// (core/setup/validate.hpp, core/step/time_scales.hpp): how many particles each fill expects, the
+// time scales and dt over the deck's particles and one particle of each fill's smallest radius, the
 // checks of the first step at that dt, and the resolved deck, which must read back.
 // Throws InputError for bad input (expected); anything else that escapes is a finding
 // (std::logic_error when a resolved deck does not read back).

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "fuzz/deck_exercise.hpp"
 
 namespace dem2d::fuzz {

@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
+#include "core/base/errors.hpp"
 #include "io/deck.hpp"
 #include "io/deck_schema.hpp"
 #include "io/run_json.hpp"

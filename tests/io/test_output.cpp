@@ -23,9 +23,9 @@
 #include <string>
 #include <vector>
 
-#include "core/errors.hpp"
-#include "core/particles.hpp"
-#include "core/scene.hpp"
+#include "core/base/errors.hpp"
+#include "core/base/scene.hpp"
+#include "core/shape/particles.hpp"
 #include "io/hdf5.hpp"
 #include "io/output_dir.hpp"
 #include "io/series.hpp"

@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "core/drum_geometry.hpp"
-#include "core/errors.hpp"
-#include "core/fill.hpp"
-#include "core/simulation.hpp"
-#include "core/validate.hpp"
+#include "core/base/errors.hpp"
+#include "core/geometry/drum_geometry.hpp"
+#include "core/setup/fill.hpp"
+#include "core/setup/validate.hpp"
+#include "core/step/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

@@ -9,7 +9,7 @@
 #include <numbers>
 #include <string>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {
@@ -121,9 +121,9 @@ TEST(Decks, ThesisDecksResolveTableOneValues) {
   EXPECT_EQ(deck("waterfall_polygon.in").drum.sides, 16);
 }
 
-// The regime classifier (core/mill_analytics.hpp) on the shipped regime decks, run whole (10 s,
-// a series row every 1 ms as the decks write them): over the last 5 s the regime of most rows
-// is the one the deck's name says, and so is the run's (the last window's).
+// The regime classifier (core/mill/mill_analytics.hpp) on the shipped regime decks, run whole (10
+// s, a series row every 1 ms as the decks write them): over the last 5 s the regime of most rows is
+// the one the deck's name says, and so is the run's (the last window's).
 TEST(Decks, RegimeDecksAreClassifiedAsTheirNamesSay) {
   const std::pair<const char*, Regime> cases[] = {{"cascade.in", Regime::kCascading},
                                                   {"cascade_cataract.in", Regime::kMixed},

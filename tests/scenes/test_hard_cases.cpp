@@ -10,8 +10,8 @@
 #include <iostream>
 #include <numbers>
 
-#include "core/disc.hpp"
-#include "core/simulation.hpp"
+#include "core/shape/disc.hpp"
+#include "core/step/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

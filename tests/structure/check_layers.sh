@@ -20,7 +20,7 @@ check_includes() {
   local dir=$1 allowed=$2
   while IFS= read -r hit; do
     violation "$hit (src/$dir may include only $allowed)"
-  done < <(grep -nHE '^\s*#\s*include\s*"' "$src/$dir"/*.{hpp,cpp} 2>/dev/null |
+  done < <(grep -rnHE --include='*.hpp' --include='*.cpp' '^\s*#\s*include\s*"' "$src/$dir" |
            grep -vE "#\s*include\s*\"($allowed)/" | sed "s|$src/|src/|")
 }
 check_includes core 'core'
@@ -30,11 +30,13 @@ check_includes io 'core|parallel|io'
 # Third-party headers the physics must not see.
 while IFS= read -r hit; do
   violation "$hit (the physics sees no MPI, HDF5, TOML, METIS or fmt)"
-done < <(grep -nHE '^\s*#\s*include\s*<(mpi|hdf5|H5[A-Za-z]*|metis|toml\+\+/|fmt/|CLI/)' "$src"/core/*.{hpp,cpp} |
+done < <(grep -rnHE --include='*.hpp' --include='*.cpp' \
+           '^\s*#\s*include\s*<(mpi|hdf5|H5[A-Za-z]*|metis|toml\+\+/|fmt/|CLI/)' "$src"/core |
          sed "s|$src/|src/|")
 while IFS= read -r hit; do
   violation "$hit (an MPI call in the physics)"
-done < <(grep -nHE '\bMPI_[A-Za-z_]+' "$src"/core/*.{hpp,cpp} | sed "s|$src/|src/|")
+done < <(grep -rnHE --include='*.hpp' --include='*.cpp' '\bMPI_[A-Za-z_]+' "$src"/core |
+         sed "s|$src/|src/|")
 
 # MPI calls outside src/parallel.
 while IFS= read -r hit; do

@@ -8,7 +8,7 @@
 #include <map>
 #include <vector>
 
-#include "core/simulation.hpp"
+#include "core/step/simulation.hpp"
 
 namespace dem2d::testing_support {
 

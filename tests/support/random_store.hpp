@@ -8,7 +8,7 @@
 #include <cstring>
 #include <random>
 
-#include "core/particles.hpp"
+#include "core/shape/particles.hpp"
 
 namespace dem2d::testing_support {
 

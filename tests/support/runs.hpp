@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "core/diagnostics.hpp"
-#include "core/simulation.hpp"
+#include "core/step/diagnostics.hpp"
+#include "core/step/simulation.hpp"
 
 namespace dem2d::testing_support {
 

@@ -4,8 +4,8 @@
 #include <random>
 #include <string>
 
-#include "core/diagnostics.hpp"
-#include "core/scene.hpp"
+#include "core/base/scene.hpp"
+#include "core/step/diagnostics.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d::testing_support {

@@ -1,0 +1,240 @@
+// Scene: the complete, validated description of one run, as plain data.
+//
+// The deck parser (src/io/deck.*) fills a Scene from a TOML `.in` file and checks every
+// value; the core builds the particle system and the simulation from it and never reads a
+// file. Every field below has the default that the deck documents (docs/input.md); units are
+// SI, angles the parser has already converted to radians.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/base/vec2.hpp"
+
+namespace dem2d {
+
+enum class ContactModelKind { kHertzMindlin, kThesis, kLinear };
+enum class RollingModelKind { kNone, kConstant, kEpsd };
+enum class IntegratorKind { kVerlet, kIterative };
+// Storage order of the particles (core/fast/spatial_order.hpp): it changes no bit of the physics.
+enum class SpatialSort { kAuto, kAlways, kNever };
+
+struct MaterialSpec {
+  std::string name;
+  double density = 0.0;             // kg/m^3
+  double youngs_modulus = 0.0;      // Pa
+  double poisson_ratio = 0.25;      // resolved: the parser derives it from shear_modulus if given
+  double shear_modulus = 0.0;       // Pa, resolved: G = E / (2 (1 + nu)) when not given
+  double restitution = 0.5;         // hertz-mindlin and linear: coefficient of restitution asked
+  double damping_normal = 0.1;      // thesis model: zeta_n (T22)
+  double damping_tangential = 0.1;  // thesis model: zeta_t (T23)
+  double sliding_friction = 0.5;    // mu_s
+  double rolling_friction = 0.0;    // mu_r (dimensionless, times R*)
+  double normal_stiffness = 0.0;    // linear model: k_n in N/m (0: derived from E at 1 % overlap)
+};
+
+// Coefficients for one pair of materials; unset values take the mean of the two materials.
+struct InteractionSpec {
+  std::string material_a;
+  std::string material_b;
+  std::optional<double> restitution;
+  std::optional<double> sliding_friction;
+  std::optional<double> rolling_friction;
+  std::optional<double> damping_normal;
+  std::optional<double> damping_tangential;
+};
+
+struct RunSpec {
+  double duration = 1.0;  // s of simulated time
+  double dt = 0.0;        // s; 0 means "auto"
+  bool dt_auto = true;
+  std::string dt_where;  // where dt was set, for messages: "deck.in:14:6", "--set run.dt=1e-3"
+  IntegratorKind integrator = IntegratorKind::kVerlet;
+  double tolerance = 1.0e-6;  // iterative: relative acceleration change (thesis T31)
+  int max_passes = 20;        // iterative
+  std::uint64_t seed = 1;
+  Vec2 gravity{0.0, -9.81};
+  double skin = -1.0;            // m, Verlet skin; < 0: 0.4 of the smallest radius (core)
+  double dt_safety = 0.2;        // fraction of min(Rayleigh time, Hertz time) used by dt = "auto"
+  bool allow_unsafe_dt = false;  // run anyway (with a warning) when dt exceeds the safe bound
+  // The run's guards (overlap, energy created, unsettled iterative passes): false, the first one
+  // that fires stops the run (exit 3); true, each is reported and the run goes on to its end, which
+  // then exits 3 all the same. A non-finite state and the motion guard always stop.
+  bool guards_warn = false;
+  int sectors_per_rank = 32;  // parallel runs: angular sectors per rank (METIS groups them)
+  double repartition_threshold = 1.05;  // parallel runs: max/mean work that triggers a repartition
+  SpatialSort spatial_sort = SpatialSort::kAuto;  // particles in space-filling-curve order
+};
+
+struct ContactSpec {
+  ContactModelKind model = ContactModelKind::kHertzMindlin;
+  RollingModelKind rolling = RollingModelKind::kEpsd;
+  double rolling_damping = 0.3;  // epsd: eta_r, the rolling dashpot's damping ratio
+  // Tracker slot: every contact records its peak strain energy (a history slot). Not a deck
+  // key: set by benchmarks and tests (breakage has its own tracker, chosen by [breakage]).
+  bool track_peak_energy = false;
+  // The breakage tracker (peak energy, the energy now, the level tested, the birth exclusion);
+  // set by the core when the scene has a [breakage] table.
+  bool track_breakage = false;
+  // The pair gather's implementation: with AVX-512 eight candidates at a time (gathers and
+  // compressed stores), else one at a time. Both give the same bits; not a deck key: tests set
+  // it to compare them.
+  bool scalar_gather = false;
+};
+
+struct LifterSpec {
+  int count = 0;         // bars evenly spaced around the shell
+  double height = 0.0;   // m, radial
+  double width = 0.0;    // m, along the shell
+  double angle = 0.0;    // rad, angular position of the first bar in the drum frame
+  std::string material;  // empty: the drum's material
+};
+
+struct DrumSpec {
+  bool present = false;
+  double radius = 0.0;
+  Vec2 center{0.0, 0.0};
+  double speed = 0.0;  // rad/s, counter-clockwise positive (resolved from rpm / critical_fraction)
+  double ramp_time = 0.0;  // s to reach the speed (linear ramp from 0)
+  int sides = 0;           // 0: exact circle; N >= 3: regular N-gon with vertices on the circle
+  double angle = 0.0;      // rad, initial drum angle
+  std::string material;
+  std::vector<LifterSpec> lifters;
+};
+
+enum class FillRegion { kBottom, kFull, kBox, kAnnulus };
+
+struct FillSpec {
+  std::string material;
+  // Exactly one source: count, fill_fraction, or file (a CSV packing).
+  std::int64_t count = 0;
+  double fill_fraction = 0.0;  // of the drum's cross-section area (sum of pi r^2)
+  std::string file;            // resolved to an absolute path by the parser
+  double radius_min = 0.0;     // mono-disperse: radius_min == radius_max
+  double radius_max = 0.0;
+  FillRegion region = FillRegion::kBottom;
+  Vec2 box_min{0.0, 0.0};  // region = "box"
+  Vec2 box_max{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};  // initial velocity of every filled particle
+  int source_line = 0;      // deck line, for error messages
+  int index = 0;            // its element of the deck's [[fill]] array: "fill[2]" in messages
+};
+
+struct ParticleSpec {
+  std::string material;
+  double radius = 0.0;
+  Vec2 position{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};
+  double spin = 0.0;  // rad/s, counter-clockwise positive
+  int source_line = 0;
+};
+
+struct WallSpec {
+  Vec2 from{0.0, 0.0};
+  Vec2 to{0.0, 0.0};
+  std::string material;
+  Vec2 velocity{0.0, 0.0};  // a translating wall (moves rigidly)
+};
+
+// Ore breakage (docs/models.md, thesis T34-T36): particles of one material break under the
+// peak strain energy of their contacts.
+struct BreakageSpec {
+  bool present = false;
+  std::string material;         // the material that breaks (ore)
+  double minimum_energy = 0.1;  // J, E_min: a contact below it does no damage (thesis Table 1)
+  double strength = 1.0;        // 1/J, S: P = 1 - exp(-S E_t) (thesis Table 1)
+  double fragments_mean = 4.0;  // fragment count: normal law, rounded and clipped
+  double fragments_sd = 2.0 / 3.0;
+  int fragments_min = 2;
+  int fragments_max = 6;
+  double minimum_radius = 0.0;  // m: particles smaller than this do not break
+  double start = 0.0;           // s: contacts that peak before this time do no damage
+};
+
+// Ore feed: one particle every `period` s (or as a mass rate), radius uniform in
+// [radius_min, radius_max], where the charge is thinnest or at `point`.
+struct FeedSpec {
+  bool present = false;
+  std::string material;
+  double period = 0.0;     // s between fed particles (0: use mass_rate)
+  double mass_rate = 0.0;  // kg/s (0: use period)
+  double radius_min = 0.0;
+  double radius_max = 0.0;
+  double start = 0.0;  // s: the first particle at this time
+  bool has_point = false;
+  Vec2 point{0.0, 0.0};
+  Vec2 velocity{0.0, 0.0};
+};
+
+// The sieve: ore whose centre is inside the box and whose radius is below the aperture leaves.
+struct SieveSpec {
+  bool present = false;
+  std::string material;      // the material it lets through (ore)
+  Vec2 box_min{-0.5, -0.5};  // thesis: 1 m x 1 m around the drum centre
+  Vec2 box_max{0.5, 0.5};
+  double aperture = 0.04;  // m, compared with the radius (docs/models.md, "Sieve")
+};
+
+struct OutputSpec {
+  std::string directory = "out";
+  double series_interval = 1.0e-3;
+  double snapshot_interval = 0.0;    // 0: final state only
+  double checkpoint_interval = 0.0;  // s of simulated time; 0: none (but at the end)
+  double checkpoint_minutes = 0.0;   // min of wall-clock time; 0: none
+  double progress_interval = 5.0;    // s of wall time between plain progress lines
+  // Mill analytics (core/mill/mill_analytics.hpp): the averaging window of power and regime, and
+  // the collision energy spectra with their size classes (edges size_class_min * ratio^k, m).
+  double analysis_window = 1.0;
+  bool collision_spectra = false;
+  double size_class_min = 0.001;
+  double size_class_ratio = 2.0;
+};
+
+struct Scene {
+  std::string title;
+  std::string deck_path;  // the deck it came from (for messages and run.json)
+  RunSpec run;
+  ContactSpec contact;
+  std::vector<MaterialSpec> materials;
+  std::vector<InteractionSpec> interactions;
+  DrumSpec drum;
+  std::vector<FillSpec> fills;  // count / fill_fraction fills: the core places them
+  // [[fill]] tables with a `file`, as a record (run.json, the resolved deck): the parser has
+  // already read each CSV into `particles`, after the [[particle]] tables, in this order; here
+  // `count` is the number of rows read and `material` / `velocity` are the defaults for rows
+  // without those columns. The core does not read this.
+  std::vector<FillSpec> file_fills;
+  std::vector<ParticleSpec> particles;
+  std::vector<WallSpec> walls;
+  BreakageSpec breakage;
+  FeedSpec feed;
+  SieveSpec sieve;
+  OutputSpec output;
+  // Where the deck gave a value that a check after reading may refuse (core/setup/validate.hpp, the
+  // fill placement), by the key's dotted path as messages name it: "run.duration" ->
+  // "deck.in:3:12", or "--set run.duration=9" when an override set it; absent for a default.
+  // "fill[K].csv" holds the CSV file of a fill from a file as messages name it.
+  std::map<std::string, std::string> where;
+};
+
+// A scene with ore models ([breakage], [feed] or [sieve]).
+inline bool is_ore_scene(const Scene& s) {
+  return s.breakage.present || s.feed.present || s.sieve.present;
+}
+
+// The contact models a scene runs: its [contact] with the trackers its tables ask for switched
+// on (breakage, which records the peak energy too; else the collision spectra's peak energy).
+inline ContactSpec active_contact(const Scene& s) {
+  ContactSpec c = s.contact;
+  c.track_breakage = s.breakage.present;
+  c.track_peak_energy = s.contact.track_peak_energy || s.output.collision_spectra;
+  return c;
+}
+
+// Index of a material by name, or -1.
+int find_material(const Scene& scene, const std::string& name);
+
+}  // namespace dem2d

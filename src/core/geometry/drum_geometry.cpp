@@ -1,0 +1,71 @@
+#include "core/geometry/drum_geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace dem2d {
+
+DrumGeometry::DrumGeometry(const DrumSpec& drum) : drum_(drum) {
+  if (!drum.present) return;
+  inner_ = drum.sides == 0 ? drum.radius : drum.radius * std::cos(std::numbers::pi / drum.sides);
+  for (std::size_t l = 0; l < drum.lifters.size(); ++l) {
+    const LifterSpec& lifter = drum.lifters[l];
+    tallest_ = std::max(tallest_, lifter.height);
+    // The feet on the circle of the drum's radius, half a width to each side of the radial.
+    const double foot = std::sqrt(drum.radius * drum.radius - 0.25 * lifter.width * lifter.width);
+    for (int k = 0; k < lifter.count; ++k) {
+      Bar b;
+      b.lifter = l;
+      b.index = k;
+      b.phi = lifter.angle + 2.0 * std::numbers::pi * k / lifter.count;
+      b.top = inner_ - lifter.height;
+      b.half_width = 0.5 * lifter.width;
+      const Vec2 radial{std::cos(b.phi), std::sin(b.phi)};
+      const Vec2 side = perp(radial);
+      b.corner = {foot * radial - b.half_width * side, b.top * radial - b.half_width * side,
+                  b.top * radial + b.half_width * side, foot * radial + b.half_width * side};
+      bars_.push_back(b);
+    }
+  }
+}
+
+Vec2 DrumGeometry::vertex(int k) const {
+  const double step = 2.0 * std::numbers::pi / drum_.sides;
+  return {drum_.radius * std::cos(k * step), drum_.radius * std::sin(k * step)};
+}
+
+double DrumGeometry::shell_clearance(Vec2 x) const {
+  const Vec2 rel = x - drum_.center;
+  double clearance = drum_.radius - norm(rel);
+  if (drum_.sides < 3) return clearance;
+  const double step = 2.0 * std::numbers::pi / drum_.sides;
+  for (int k = 0; k < drum_.sides; ++k) {
+    const double phi = drum_.angle + (k + 0.5) * step;  // the outward normal of side k
+    clearance = std::min(clearance, inner_ - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
+  }
+  return clearance;
+}
+
+// Each bar as a rectangle from its top face to the drum's radius, in the lab frame at the drum's
+// initial angle; sets whose top faces all lie beyond the disc's reach are skipped.
+std::optional<LifterOverlap> DrumGeometry::bar_overlap(Vec2 x, double r) const {
+  if (!drum_.present) return std::nullopt;
+  const Vec2 rel = x - drum_.center;
+  const double distance = norm(rel);
+  for (const Bar& b : bars_) {
+    if (distance + r <= b.top) continue;  // nearer the axis than the bar
+    const double phi = drum_.angle + b.phi;
+    const Vec2 radial{std::cos(phi), std::sin(phi)};
+    const double s = dot(rel, radial);        // along the bar, from the axis
+    const double t = dot(rel, perp(radial));  // across it
+    const double dx = std::max({b.top - s, s - drum_.radius, 0.0});
+    const double dy = std::max(std::abs(t) - b.half_width, 0.0);
+    const bool inside = dx == 0.0 && dy == 0.0;
+    if (inside || dx * dx + dy * dy < r * r)
+      return LifterOverlap{b.lifter, b.index, inside, std::sqrt(dx * dx + dy * dy)};
+  }
+  return std::nullopt;
+}
+
+}  // namespace dem2d

@@ -1,0 +1,13 @@
+#include "core/step/energy_ledger.hpp"
+
+#include "core/shape/disc.hpp"
+
+namespace dem2d {
+
+double mechanical_energy(const ParticleStore& p, std::size_t k, Vec2 gravity) {
+  return 0.5 * p.mass[k] * norm2(p.vel[k]) +
+         Disc::rotational_energy(p.mass[k], p.radius[k], p.omega[k]) -
+         p.mass[k] * dot(gravity, p.pos[k]);
+}
+
+}  // namespace dem2d
