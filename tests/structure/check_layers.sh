@@ -8,6 +8,7 @@
 #              (the MPI_Comm handle and H5Pset_fapl_mpio for collective HDF5 are allowed);
 #   app/       calls no MPI function but MPI_Finalize, MPI_Comm_rank, MPI_Comm_size (MPI starts
 #              with parallel's mpi::init).
+# Also: the tree of src/ in README.md names exactly the folders of src/ and src/core.
 # Prints every violation with its file and line; exit 1 if there is any.
 set -u
 src=$1/src
@@ -54,6 +55,14 @@ else
   syms=$(nm -u "$core_lib" | awk '{print $NF}' | grep -E '^(MPI_|PMPI_|ompi_|H5)' | sort -u)
   [ -n "$syms" ] && violation "dem2d_core references $(wc -l <<<"$syms") MPI/HDF5 symbols: $(head -5 <<<"$syms" | tr '\n' ' ')..."
 fi
+
+# The README's tree of src/ names every room (folder) of src/ and src/core, and no other.
+readme_rooms=$(awk '/^src\/$/{on=1; next} on && /^```/{exit} on' "$1/README.md" |
+  sed -nE 's|^  ([a-z]+)/.*|\1|p; s|^    ([a-z]+)/.*|core/\1|p' | sort)
+code_rooms=$( (cd "$src" && find . -mindepth 1 -maxdepth 1 -type d -printf '%f\n' &&
+  find core -mindepth 1 -maxdepth 1 -type d) | sort)
+[ "$readme_rooms" = "$code_rooms" ] ||
+  violation "README.md's tree of src/ lists [$(echo $readme_rooms)], the code has [$(echo $code_rooms)]"
 
 if [ "$failures" -gt 0 ]; then
   echo "check_layers: $failures violation(s)"

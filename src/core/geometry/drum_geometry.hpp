@@ -3,7 +3,7 @@
 // that turns with the drum; at t = 0 it is turned by drum.angle from the lab). The walls build
 // their elements from it, the fill keeps its lattice inside it, the placement checks measure
 // particles against it, and the mill analytics and the feed take its radii (docs/models.md,
-// "Drum and lifters").
+// "Walls").
 //
 // A lifter bar is a rectangle of the lifter's width standing on the shell, radial, its top face
 // `height` from the shell's inner surface at its foot (the circle, or the polygon's inscribed

@@ -1,7 +1,7 @@
 // The energy ledger: where the energy of a run went, this rank's share of each sum since the
 // start (J). The balance kinetic + rotational + potential + elastic + dissipated - drive work
 // - fed + discharged stays constant up to the integrator's error (docs/models.md, "Energy
-// ledger"); Simulation keeps one ledger, checkpoints save it, the series reports its sums.
+// bookkeeping"); Simulation keeps one ledger, checkpoints save it, the series reports its sums.
 #pragma once
 
 #include <cstddef>
