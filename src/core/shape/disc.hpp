@@ -1,5 +1,6 @@
 // The disc: the particle shape of the thesis's balls and ore, a sphere of radius r whose centre
-// moves in the plane (docs/models.md, "Bodies and frame"). A shape owns what depends on the body's form:
+// moves in the plane (docs/models.md, "Bodies and frame"). A shape owns what depends on the body's
+// form:
 //   mass, inertia             from its size and density (a 3D sphere: 4/3 pi r^3 rho, 2/5 m r^2)
 //   rotational_energy         1/2 I w^2 with its own inertia
 //   contact_inertia           I + m r^2 about the contact point (rolling models)
