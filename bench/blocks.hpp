@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "settled_drum.hpp"
 
 namespace bench {

@@ -27,7 +27,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "settled_drum.hpp"
 
 namespace {

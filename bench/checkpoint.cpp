@@ -54,7 +54,7 @@
 #include <vector>
 
 #include "blocks.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "parallel/mpi_domain.hpp"

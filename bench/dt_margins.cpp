@@ -37,7 +37,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "settled_drum.hpp"
 
 namespace dem2d {

@@ -36,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

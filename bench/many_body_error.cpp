@@ -49,7 +49,7 @@
 #include <vector>
 
 #include "core/base/errors.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

@@ -92,7 +92,7 @@
 #include <vector>
 
 #include "core/base/scene.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "deposition.hpp"
 
 namespace bench {

@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "blocks.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "lists.hpp"
 #include "settled_drum.hpp"
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "core/step/time_scales.hpp"
 #include "settled_drum.hpp"
 

@@ -41,7 +41,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 #include "parallel/mpi_domain.hpp"
 #include "settled_drum.hpp"

@@ -99,7 +99,7 @@
 #include <vector>
 
 #include "core/base/errors.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 #include "lists.hpp"
 #include "settled_drum.hpp"

@@ -61,7 +61,7 @@
 #include "core/base/errors.hpp"
 #include "core/shape/disc.hpp"
 #include "core/shape/particles.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace {

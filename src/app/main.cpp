@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "core/base/errors.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/check_report.hpp"
 #include "io/checkpoint.hpp"
 #include "io/console.hpp"

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 
 namespace dem2d {
 

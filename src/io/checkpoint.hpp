@@ -25,7 +25,7 @@
 
 #include <string>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "parallel/comm.hpp"
 
 namespace dem2d {

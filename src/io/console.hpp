@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <string>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 
 namespace dem2d {
 

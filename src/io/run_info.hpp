@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/run_json.hpp"
 #include "parallel/mpi_domain.hpp"
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "core/step/domain.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/console.hpp"
 #include "io/run_outputs.hpp"
 #include "io/snapshots.hpp"

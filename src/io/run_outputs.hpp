@@ -6,7 +6,7 @@
 
 #include <memory>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/ore_logs.hpp"
 #include "io/series.hpp"
 

@@ -16,7 +16,7 @@
 #include <string>
 
 #include "core/base/scene.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

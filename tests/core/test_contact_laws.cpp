@@ -19,7 +19,7 @@
 #include "core/base/scene.hpp"
 #include "core/contact/contact_models.hpp"
 #include "core/contact/materials.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
 #include "support/runs.hpp"

@@ -9,7 +9,7 @@
 #include "core/contact/materials.hpp"
 #include "core/setup/fill.hpp"
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

@@ -10,7 +10,7 @@
 
 #include "core/contact/contact_models.hpp"
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

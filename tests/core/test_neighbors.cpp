@@ -15,7 +15,7 @@
 #include "core/contact/neighbors.hpp"
 #include "core/geometry/walls.hpp"
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "core/fast/pair_gather.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/thesis.hpp"
 

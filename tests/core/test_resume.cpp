@@ -1,4 +1,4 @@
-// Resuming a run (core/step/run_state.hpp): a simulation rebuilt from another's particles, contact
+// Resuming a run (core/run/run_state.hpp): a simulation rebuilt from another's particles, contact
 // histories and run state continues bit for bit as the original does, for both integrators and
 // through breakage, feed and sieve. (The checkpoint file and the rank counts: tests/io and the
 // cli tests.)
@@ -6,7 +6,7 @@
 
 #include <numeric>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/thesis.hpp"
 

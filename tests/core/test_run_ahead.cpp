@@ -14,7 +14,7 @@
 
 #include "core/fast/kinematics_mirror.hpp"
 #include "core/step/integrators.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
 #include "support/thesis.hpp"

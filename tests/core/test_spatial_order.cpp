@@ -13,7 +13,7 @@
 
 #include "core/contact/contact_kernel.hpp"
 #include "core/fast/spatial_order.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/compare.hpp"
 #include "support/thesis.hpp"
 

@@ -15,7 +15,7 @@
 
 #include "core/base/errors.hpp"
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

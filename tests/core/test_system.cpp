@@ -27,7 +27,7 @@
 
 #include "core/base/random.hpp"
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

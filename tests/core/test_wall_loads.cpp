@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "core/geometry/wall_loads.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {

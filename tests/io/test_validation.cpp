@@ -18,7 +18,7 @@
 #include "core/geometry/drum_geometry.hpp"
 #include "core/setup/fill.hpp"
 #include "core/setup/validate.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

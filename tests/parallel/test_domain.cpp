@@ -31,7 +31,7 @@
 #include <string>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "parallel/mpi_domain.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -9,7 +9,7 @@
 #include <numbers>
 #include <string>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

@@ -11,7 +11,7 @@
 #include <numbers>
 
 #include "core/shape/disc.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

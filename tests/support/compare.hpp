@@ -8,7 +8,7 @@
 #include <map>
 #include <vector>
 
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 
 namespace dem2d::testing_support {
 

@@ -6,7 +6,7 @@
 #include <cstddef>
 
 #include "core/step/diagnostics.hpp"
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 
 namespace dem2d::testing_support {
 

@@ -4,7 +4,7 @@
 // trivial and is what the core's tests use. src/parallel/ implements them with MPI (angular
 // sectors, halo exchange, migration) without the physics ever seeing MPI.
 //
-// When the core calls them (Simulation::rebuild and refresh_ghosts in core/step/simulation.cpp, the
+// When the core calls them (Simulation::rebuild and refresh_ghosts in core/run/simulation.cpp, the
 // end-of-step round in core/step/integrators.cpp):
 //   construction: every rank holds the same full set of particles -> adopt() keeps this
 //     rank's own, then the first rebuild;

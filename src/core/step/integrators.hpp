@@ -51,7 +51,7 @@ class RebuildMonitor {
   WallPose walls_at_build_;
 };
 
-// The stages of a step that belong to the simulation as a whole (core/step/simulation.cpp); an
+// The stages of a step that belong to the simulation as a whole (core/run/simulation.cpp); an
 // integrator calls them in its order.
 class StepStages {
  public:

@@ -35,8 +35,8 @@
 #include "core/step/domain.hpp"
 #include "core/step/energy_ledger.hpp"
 #include "core/step/integrators.hpp"
-#include "core/step/run_state.hpp"
-#include "core/step/state_backup.hpp"
+#include "core/run/run_state.hpp"
+#include "core/run/state_backup.hpp"
 #include "core/step/time_scales.hpp"
 
 namespace dem2d {
@@ -91,7 +91,7 @@ class Simulation final : private StepStages {
   // InputError for an impossible placement or an unsafe dt.
   // With `resume`, the particles, histories and state are the checkpoint's instead, and the
   // run continues exactly where it stopped: the next step() is the one the interrupted run
-  // would have taken (core/step/run_state.hpp says what is rebuilt rather than restored).
+  // would have taken (core/run/run_state.hpp says what is rebuilt rather than restored).
   explicit Simulation(const Scene& scene, Domain* domain = nullptr,
                       const Resumption* resume = nullptr);
 

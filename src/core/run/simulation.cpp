@@ -1,4 +1,4 @@
-#include "core/step/simulation.hpp"
+#include "core/run/simulation.hpp"
 
 #include <algorithm>
 #include <cmath>
