@@ -59,9 +59,9 @@
 #include <vector>
 
 #include "core/base/errors.hpp"
+#include "core/run/simulation.hpp"
 #include "core/shape/disc.hpp"
 #include "core/shape/particles.hpp"
-#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace {

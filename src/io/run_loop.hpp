@@ -6,8 +6,8 @@
 #include <chrono>
 #include <cstdint>
 
-#include "core/step/domain.hpp"
 #include "core/run/simulation.hpp"
+#include "core/step/domain.hpp"
 #include "io/console.hpp"
 #include "io/run_outputs.hpp"
 #include "io/snapshots.hpp"

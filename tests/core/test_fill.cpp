@@ -7,9 +7,9 @@
 #include "core/base/errors.hpp"
 #include "core/contact/contact_models.hpp"
 #include "core/contact/materials.hpp"
+#include "core/run/simulation.hpp"
 #include "core/setup/fill.hpp"
 #include "core/shape/disc.hpp"
-#include "core/run/simulation.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

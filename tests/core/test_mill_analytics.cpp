@@ -9,8 +9,8 @@
 #include <numbers>
 
 #include "core/mill/mill_analytics.hpp"
-#include "core/shape/disc.hpp"
 #include "core/run/simulation.hpp"
+#include "core/shape/disc.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

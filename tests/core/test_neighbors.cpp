@@ -14,8 +14,8 @@
 #include "core/base/random.hpp"
 #include "core/contact/neighbors.hpp"
 #include "core/geometry/walls.hpp"
-#include "core/shape/disc.hpp"
 #include "core/run/simulation.hpp"
+#include "core/shape/disc.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 

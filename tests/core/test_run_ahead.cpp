@@ -13,8 +13,8 @@
 #include <utility>
 
 #include "core/fast/kinematics_mirror.hpp"
-#include "core/step/integrators.hpp"
 #include "core/run/simulation.hpp"
+#include "core/step/integrators.hpp"
 #include "support/compare.hpp"
 #include "support/random_store.hpp"
 #include "support/thesis.hpp"

@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "core/base/errors.hpp"
-#include "core/shape/disc.hpp"
 #include "core/run/simulation.hpp"
+#include "core/shape/disc.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "core/base/random.hpp"
-#include "core/shape/disc.hpp"
 #include "core/run/simulation.hpp"
+#include "core/shape/disc.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -16,9 +16,9 @@
 
 #include "core/base/errors.hpp"
 #include "core/geometry/drum_geometry.hpp"
+#include "core/run/simulation.hpp"
 #include "core/setup/fill.hpp"
 #include "core/setup/validate.hpp"
-#include "core/run/simulation.hpp"
 #include "io/deck.hpp"
 
 namespace dem2d {

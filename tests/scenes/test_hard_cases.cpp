@@ -10,8 +10,8 @@
 #include <iostream>
 #include <numbers>
 
-#include "core/shape/disc.hpp"
 #include "core/run/simulation.hpp"
+#include "core/shape/disc.hpp"
 #include "support/runs.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"

@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <cstddef>
 
-#include "core/step/diagnostics.hpp"
 #include "core/run/simulation.hpp"
+#include "core/step/diagnostics.hpp"
 
 namespace dem2d::testing_support {
 

@@ -30,13 +30,13 @@
 #include "core/geometry/walls.hpp"
 #include "core/mill/grinding.hpp"
 #include "core/mill/mill_analytics.hpp"
+#include "core/run/run_state.hpp"
+#include "core/run/state_backup.hpp"
 #include "core/shape/particles.hpp"
 #include "core/step/diagnostics.hpp"
 #include "core/step/domain.hpp"
 #include "core/step/energy_ledger.hpp"
 #include "core/step/integrators.hpp"
-#include "core/run/run_state.hpp"
-#include "core/run/state_backup.hpp"
 #include "core/step/time_scales.hpp"
 
 namespace dem2d {
