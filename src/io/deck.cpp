@@ -572,7 +572,8 @@ class DeckParser {
   // lifter bars (else it would fall forever outside the drum, or start inside a bar).
   void check_feed_point(const TableReader& r, const FeedSpec& f) {
     const DrumSpec& d = scene_.drum;
-    const double clearance = DrumGeometry(d).shell_clearance(f.point);
+    const DrumGeometry drum(d);
+    const double clearance = drum.shell_clearance(f.point);
     if (clearance < f.radius_max) {
       r.invalid("point",
                 fmt::format("a fed particle of radius_max {:g} m {} the drum (radius {:g} "
@@ -581,7 +582,7 @@ class DeckParser {
                             f.radius_max,
                             clearance <= -f.radius_max ? "lies outside" : "straddles the shell of",
                             d.radius, d.center.x, d.center.y));
-    } else if (const auto bar = DrumGeometry(d).bar_overlap(f.point, f.radius_max)) {
+    } else if (const auto bar = drum.bar_overlap(f.point, f.radius_max)) {
       r.invalid("point", fmt::format("a fed particle of radius_max {:g} m {} bar {} of "
                                      "drum.lifter[{}]; give a point clear of the lifters",
                                      f.radius_max, bar->inside ? "lies inside" : "overlaps",

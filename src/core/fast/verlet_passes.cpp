@@ -4,23 +4,6 @@
 
 namespace dem2d {
 
-double accelerations(ParticleStore& p, Vec2 gravity) {
-  const std::size_t n = p.n_owned();
-  Vec2* a = p.acc.data();
-  double* al = p.alpha.data();
-  const Vec2* f = p.force.data();
-  const double* tq = p.torque.data();
-  const double* inv_m = p.inv_mass.data();
-  const double* inv_i = p.inv_inertia.data();
-  double checksum = 0.0;
-#pragma omp simd reduction(+ : checksum)
-  for (std::size_t k = 0; k < n; ++k) {
-    accelerate(a[k], al[k], f[k], tq[k], inv_m[k], inv_i[k], gravity);
-    checksum += (a[k].x + a[k].y) + al[k];
-  }
-  return checksum;
-}
-
 namespace {
 
 // The opening half kick and drift of particle k (kick_drift) and what it writes: x, v, w,

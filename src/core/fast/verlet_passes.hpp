@@ -21,9 +21,6 @@ namespace dem2d {
   a = inv_m * f + gravity;
   alpha = inv_i * torque;
 }
-// The same for the owned particles. Returns a checksum (a plain sum: any NaN or infinity makes
-// it non-finite).
-double accelerations(ParticleStore& p, Vec2 gravity);
 
 // Velocity Verlet's opening half kick and drift of one particle. The same operations serve the
 // owned particles and the state a halo source's ghosts are handed ahead, so the bits agree.

@@ -9,6 +9,13 @@ namespace dem2d {
 DrumGeometry::DrumGeometry(const DrumSpec& drum) : drum_(drum) {
   if (!drum.present) return;
   inner_ = drum.sides == 0 ? drum.radius : drum.radius * std::cos(std::numbers::pi / drum.sides);
+  if (drum.sides >= 3) {
+    const double step = 2.0 * std::numbers::pi / drum.sides;
+    for (int k = 0; k < drum.sides; ++k) {
+      const double phi = drum.angle + (k + 0.5) * step;  // the outward normal of side k
+      side_normals_.push_back({std::cos(phi), std::sin(phi)});
+    }
+  }
   for (std::size_t l = 0; l < drum.lifters.size(); ++l) {
     const LifterSpec& lifter = drum.lifters[l];
     tallest_ = std::max(tallest_, lifter.height);
@@ -21,6 +28,8 @@ DrumGeometry::DrumGeometry(const DrumSpec& drum) : drum_(drum) {
       b.phi = lifter.angle + 2.0 * std::numbers::pi * k / lifter.count;
       b.top = inner_ - lifter.height;
       b.half_width = 0.5 * lifter.width;
+      const double phi_at_start = drum.angle + b.phi;
+      b.radial_at_start = {std::cos(phi_at_start), std::sin(phi_at_start)};
       const Vec2 radial{std::cos(b.phi), std::sin(b.phi)};
       const Vec2 side = perp(radial);
       b.corner = {foot * radial - b.half_width * side, b.top * radial - b.half_width * side,
@@ -38,12 +47,8 @@ Vec2 DrumGeometry::vertex(int k) const {
 double DrumGeometry::shell_clearance(Vec2 x) const {
   const Vec2 rel = x - drum_.center;
   double clearance = drum_.radius - norm(rel);
-  if (drum_.sides < 3) return clearance;
-  const double step = 2.0 * std::numbers::pi / drum_.sides;
-  for (int k = 0; k < drum_.sides; ++k) {
-    const double phi = drum_.angle + (k + 0.5) * step;  // the outward normal of side k
-    clearance = std::min(clearance, inner_ - dot(rel, Vec2{std::cos(phi), std::sin(phi)}));
-  }
+  for (const Vec2 normal : side_normals_)
+    clearance = std::min(clearance, inner_ - dot(rel, normal));
   return clearance;
 }
 
@@ -55,8 +60,7 @@ std::optional<LifterOverlap> DrumGeometry::bar_overlap(Vec2 x, double r) const {
   const double distance = norm(rel);
   for (const Bar& b : bars_) {
     if (distance + r <= b.top) continue;  // nearer the axis than the bar
-    const double phi = drum_.angle + b.phi;
-    const Vec2 radial{std::cos(phi), std::sin(phi)};
+    const Vec2 radial = b.radial_at_start;
     const double s = dot(rel, radial);        // along the bar, from the axis
     const double t = dot(rel, perp(radial));  // across it
     const double dx = std::max({b.top - s, s - drum_.radius, 0.0});

@@ -39,6 +39,7 @@ class DrumGeometry {
     double phi = 0.0;        // the bar's radial direction, rad, in the drum frame
     double top = 0.0;        // the top face's distance from the centre
     double half_width = 0.0;
+    Vec2 radial_at_start{};  // (cos, sin) of drum.angle + phi: the bar's direction at t = 0
     // The exposed outline: foot, top corner, top corner, foot (the three sides p0-p1, p1-p2,
     // p2-p3 are wall elements).
     std::array<Vec2, 4> corner{};
@@ -70,6 +71,7 @@ class DrumGeometry {
  private:
   DrumSpec drum_;
   double inner_ = 0.0, tallest_ = 0.0;
+  std::vector<Vec2> side_normals_;  // the polygon's outward side normals at t = 0
   std::vector<Bar> bars_;
 };
 

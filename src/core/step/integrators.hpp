@@ -162,6 +162,10 @@ class Integrator {
 
 std::unique_ptr<Integrator> make_integrator(const RunSpec& run, double dt, Vec2 gravity);
 
+// a = F/m + g and alpha = M/I of the owned particles (accelerate, core/fast/verlet_passes.hpp).
+// Returns a checksum (a plain sum: any NaN or infinity makes it non-finite).
+double accelerations(ParticleStore& p, Vec2 gravity);
+
 // Velocity Verlet (kick-drift-kick); the velocity-dependent forces see the half-step velocity.
 class VelocityVerlet final : public Integrator {
  public:
