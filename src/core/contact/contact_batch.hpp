@@ -82,15 +82,18 @@ struct ContactBatch : BatchColumns<ContactBatch> {
   Array<double> spin;       // w_i r_i + w_j r_j
   Array<double> omega_rel;  // w_i - w_j
   Array<double> counted;    // 1: this rank books the contact's energies and count, 0: not
+  // Each body's spin and angle, for a shape whose arms leave the normal (else not written).
+  Array<double> w_i, w_j, th_i, th_j;
   // Outputs (phase B).
   Array<double> fx, fy;    // force on i (on j: the opposite)
   Array<double> t_i, t_j;  // torques on i and on j
   Array<double> overlap;   // delta / min(r_i, r_j)
   Array<double> ex, ey;    // the elastic normal force on i (ContactForceT::f_el)
 
-  std::array<Array<double>*, 12 + kMaxHistorySlots> inputs() {
-    return with_history<12>(
-        {&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel, &counted}, history);
+  std::array<Array<double>*, 16 + kMaxHistorySlots> inputs() {
+    return with_history<16>({&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
+                             &counted, &w_i, &w_j, &th_i, &th_j},
+                            history);
   }
   std::array<Array<double>*, 7> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap, &ex, &ey}; }
 };
@@ -106,13 +109,17 @@ struct WallBatch : BatchColumns<WallBatch> {
   Array<double> omega_rel;  // w_i - Omega_wall
   Array<double> wx, wy;     // wall velocity at the contact point (scatter only)
   Array<double> px, py;     // contact point (scatter only)
+  // For a shape whose arms leave the normal (else not written): the arm (contact point minus
+  // centre) and the radius of curvature at the contact.
+  Array<double> ax, ay, r_eff;
   // Outputs (phase B).
   Array<double> fx, fy, torque, m_roll;
   Array<double> diss_law, el_law, diss_roll, el_roll;
   Array<double> ex, ey;  // the elastic normal force (ContactForceT::f_el)
 
-  std::array<Array<double>*, 8 + kMaxHistorySlots> inputs() {
-    return with_history<8>({&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel}, history);
+  std::array<Array<double>*, 11 + kMaxHistorySlots> inputs() {
+    return with_history<11>({&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &ax, &ay, &r_eff},
+                            history);
   }
   std::array<Array<double>*, 14> outputs() {
     return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque,

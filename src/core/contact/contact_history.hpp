@@ -17,14 +17,9 @@
 #include <string_view>
 #include <vector>
 
-namespace dem2d {
+#include "core/base/history_slot.hpp"
 
-// One declared history value of a contact.
-struct HistorySlot {
-  std::string_view name;  // e.g. "xi"
-  std::string_view unit;  // SI, e.g. "m"
-  std::string_view doc;   // one line
-};
+namespace dem2d {
 
 // Contact histories keyed by particle ids. Key (a, b): b >= 0 the pair of particles a < b;
 // b < 0 particle a against wall element -1 - b. Each record holds width() values.

@@ -66,26 +66,34 @@ inline std::size_t padded(std::size_t n) { return (n + kPackSize - 1) / kPackSiz
 // ahead (Kernel::scatter_pairs).
 inline constexpr std::size_t kScatterPrefetchFrom = 50000;
 
-// The force loop for one contact model (docs/architecture.md, "Code conventions": written once, the
-// model chosen at setup). Particle-particle contacts in canonical (lower id first, sorted) order,
-// in chunks, then particle-wall contacts; each in the three phases of contact_batch.hpp. Both paths
-// call Model::evaluate for the physics; they differ only in the geometry they gather and in what
-// they scatter.
-template <class Model>
+// The force loop for one contact model and particle shape (docs/architecture.md, "Code
+// conventions": written once, the model chosen at setup). Particle-particle contacts in canonical
+// (lower id first, sorted) order, in chunks, then particle-wall contacts; each in the three phases
+// of contact_batch.hpp. Both paths call Model::evaluate for the physics; they differ only in the
+// geometry they gather and in what they scatter.
+//
+// Shape: the particle shape's narrow phase and inertia (core/shape/disc.hpp). The disc's arms lie
+// along the normal, and its kernels take the disc's forms of arm x force and v + w x arm on
+// scalars of the normal frame (and its pairs' gather, which may be vector); a shape whose arms
+// leave the normal gets the vector forms, the scalar gather with each body's spin and angle,
+// its own history slots after the model's, and lanes out of contact (its bounding circles
+// overlap, its bodies do not) masked out.
+template <class Model, class Shape = Disc>
 class Kernel final : public ContactKernel {
-  // The particle shape's narrow phase and inertia (core/shape/disc.hpp); the gather is the disc's.
-  using Shape = Disc;
-  static_assert(Shape::kArmsAlongNormal,
-                "the torques and surface velocities below take arms along n");
   using Coeffs = typename Model::template Coeffs<double>;
-  static constexpr std::size_t W = Model::kHistoryWidth;
+  static constexpr std::size_t kModelWidth = Model::kHistoryWidth;
+  static constexpr std::size_t kShapeWidth = Shape::kHistory.size();
+  static constexpr std::size_t W = kModelWidth + kShapeWidth;
   static_assert(W <= kMaxHistorySlots, "raise kMaxHistorySlots");
+  static_assert(!Shape::kArmsAlongNormal || kShapeWidth == 0,
+                "a shape with history of its own takes the general path (kArmsAlongNormal false)");
+  static constexpr bool kArmsApart = !Shape::kArmsAlongNormal;
 
  public:
   Kernel(const ContactSpec& spec, const PairTable& table)
       : n_mat_(table.n_materials()),
-        slots_(Model::history_slots()),
-        vector_gather_(kHaveVectorGather && !spec.scalar_gather) {
+        slots_(all_slots()),
+        vector_gather_(kHaveVectorGather && !spec.scalar_gather && !kArmsApart) {
     for (int a = 0; a < n_mat_; ++a)
       for (int b = 0; b < n_mat_; ++b) coeffs_.push_back(Model::coeffs(table(a, b), spec));
     if (!coeffs_.empty()) uniform_ = broadcast(0);  // a scene without materials has no contacts
@@ -128,6 +136,12 @@ class Kernel final : public ContactKernel {
   }
 
  private:
+  // The model's slots, then the shape's.
+  static std::vector<HistorySlot> all_slots() {
+    std::vector<HistorySlot> out = Model::history_slots();
+    out.insert(out.end(), Shape::kHistory.begin(), Shape::kHistory.end());
+    return out;
+  }
   typename Model::template Coeffs<Pack> broadcast(std::int32_t k) const {
     return Model::broadcast(coeffs_[k]);
   }
@@ -186,6 +200,14 @@ class Kernel final : public ContactKernel {
                     std::int32_t element, double dt, const double* h);
   void evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated, EightLanes& elastic,
                       Pack& overlap);
+  void evaluate_pairs_apart(std::size_t n, double dt, EightLanes& dissipated, EightLanes& elastic,
+                            Pack& overlap);
+  // What one pack of pairs hands to the batch (put_pack).
+  struct PackOut {
+    Pack fx, fy, ti, tj, diss, el, ratio, ex, ey;
+  };
+  void put_pack(std::size_t c, std::size_t n, const PackOut& o, EightLanes& dissipated,
+                EightLanes& elastic, Pack& overlap);
   void scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n);
   void note_tests_due(std::size_t n);
   void write_records(PairList& pl, std::size_t n);
@@ -200,6 +222,9 @@ class Kernel final : public ContactKernel {
   // The wall entries in list order, their histories read from the committed slots and rewritten
   // into the trial slots.
   std::size_t gather_walls(const ParticleStore& p, const Walls& walls, WallPairList& wl);
+  std::size_t put_wall(std::size_t n, std::size_t k, std::int32_t i, std::int32_t coeff,
+                       const WallGeometry& g, Vec2 vrel, Vec2 vw, double omega_rel,
+                       const ParticleStore& p, const double* old);
   void evaluate_walls(std::size_t n, double dt);
   // Forces, energies and histories of the wall contacts; one load record each into `loads`.
   void scatter_walls(ParticleStore& p, WallPairList& wl, std::size_t n, EvaluationTotals& tot,

@@ -1,4 +1,4 @@
-// The particle-pair contacts of the force kernel (Kernel<Model>, contact_kernel.hpp), in the
+// The particle-pair contacts of the force kernel (Kernel<Model, Shape>, contact_kernel.hpp), in the
 // three phases of contact_batch.hpp: A. gather the pairs in contact, B. evaluate the model on
 // packs, C. scatter forces, torques and histories in canonical order.
 #pragma once
@@ -13,8 +13,8 @@ namespace dem2d::kernels {
 // arrays stay in the L1/L2 cache (one pass over a batch of every contact streamed 20 arrays
 // through memory: 1.7x slower per particle-step at 1e5 particles). Chunks run in list order, so
 // the scatter stays canonical.
-template <class Model>
-void Kernel<Model>::prepare_pairs([[maybe_unused]] ParticleStore& p, PairList& pl) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::prepare_pairs([[maybe_unused]] ParticleStore& p, PairList& pl) {
   b_.reserve(kChunk + kPackSize);
   if (bi_.size() < kChunk + kPackSize) {
     bi_.resize(kChunk + kPackSize);
@@ -34,10 +34,10 @@ void Kernel<Model>::prepare_pairs([[maybe_unused]] ParticleStore& p, PairList& p
 }
 
 // Candidates [k0, k1): phases A, B and C.
-template <class Model>
-[[gnu::always_inline]] inline void Kernel<Model>::pair_chunk(ParticleStore& p, PairList& pl,
-                                                             std::size_t k0, std::size_t k1,
-                                                             double dt, PairTotals& t) {
+template <class Model, class Shape>
+[[gnu::always_inline]] inline void Kernel<Model, Shape>::pair_chunk(ParticleStore& p, PairList& pl,
+                                                                    std::size_t k0, std::size_t k1,
+                                                                    double dt, PairTotals& t) {
   const std::size_t n = gather_pairs(p, pl, k0, k1);
   Pack chunk_overlap(0.0);
   evaluate_pairs(n, dt, t.dissipated, t.elastic, chunk_overlap);
@@ -62,9 +62,9 @@ template <class Model>
   t.max_ratio = std::max(t.max_ratio, chunk_max);
 }
 
-template <class Model>
-void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
-                                  EvaluationTotals& tot) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
+                                         EvaluationTotals& tot) {
   prepare_pairs(p, pl);
   PairTotals t;
   for (std::size_t k0 = 0; k0 < pl.size(); k0 += kChunk)
@@ -75,9 +75,9 @@ void Kernel<Model>::pair_contacts(ParticleStore& p, PairList& pl, double dt,
 
 // A. Gather the pairs in contact among candidates [k0, k1) (core/fast/pair_gather.hpp); pairs apart
 // lose their history (what their springs held is released: release_ended).
-template <class Model>
-std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
-                                        std::size_t k1) {
+template <class Model, class Shape>
+std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0,
+                                               std::size_t k1) {
   if constexpr (!kInPlace)  // the scatter rewrites the contacts'
     std::fill(pl.trial.data() + k0 * W, pl.trial.data() + k1 * W, 0.0);
   std::array<double*, W + 1> old{};  // W may be 0
@@ -111,7 +111,12 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
                            .vy = b_.vy.data(),
                            .spin = b_.spin.data(),
                            .omega_rel = b_.omega_rel.data(),
-                           .old = old.data()};
+                           .old = old.data(),
+                           .theta = kArmsApart ? p.theta.data() : nullptr,
+                           .w_i = b_.w_i.data(),
+                           .w_j = b_.w_j.data(),
+                           .th_i = b_.th_i.data(),
+                           .th_j = b_.th_j.data()};
   std::size_t n = 0;
 #if DEM2D_VECTOR_GATHER
   if (vector_gather_) n = gather_contacts_vector<W>(kin_.data(), cols, k0, k1);
@@ -123,6 +128,7 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
     for (std::size_t c = 0; c < n; ++c) touch[b_.pair[c]] = 1;
   }
   if (!vector_gather_ && n > 0) gather_inputs_scalar(cols, 0, n);
+  if constexpr (kArmsApart) gather_frames_scalar(cols, 0, n);
   // In place: the committed histories of the chunk are read; the scatter rewrites the contacts'.
   if constexpr (kInPlace) std::fill(pl.history.data() + k0 * W, pl.history.data() + k1 * W, 0.0);
   if (n == 0) return 0;
@@ -136,13 +142,97 @@ std::size_t Kernel<Model>::gather_pairs(const ParticleStore& p, PairList& pl, st
 }
 
 // B. The contact model on packs of kPackSize contacts.
-template <class Model>
-void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated,
-                                   EightLanes& elastic, Pack& overlap) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated,
+                                          EightLanes& elastic, Pack& overlap) {
+  if constexpr (kArmsApart) {
+    evaluate_pairs_apart(n, dt, dissipated, elastic, overlap);
+  } else {
+    for (std::size_t c = 0; c < padded(n); c += kPackSize) {
+      const Pack ri = load(b_.r_i, c), rj = load(b_.r_j, c);
+      const PairContactT<Pack> g =
+          Shape::pair(load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj);
+      const Pack nx = g.nx, ny = g.ny;
+      const Pack tx = -ny, ty = nx;
+      const Pack mi = load(b_.m_i, c), mj = load(b_.m_j, c);
+      KinematicsT<Pack> kin;
+      kin.delta = g.delta;
+      kin.r_eff = g.r_eff;
+      kin.m_eff = mi * mj / (mi + mj);
+      if constexpr (Model::Rolling::kNeedsInertia) {
+        // About the contact point; harmonic mean of the two bodies.
+        const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
+        kin.i_eff = ia * ib / (ia + ib);
+      }
+      const Pack spin = load(b_.spin, c);
+      project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
+      kin.omega_rel = load(b_.omega_rel, c);
+      const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
+      const ContactForceT<Pack>& cf = out.law;
+      const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
+      // Arms along the normal (Shape::kArmsAlongNormal): arm x force = arm f_t.
+      const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_i;
+      const Pack arm_j = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_j;
+      Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
+      Pack diss = cf.dissipated, el = cf.elastic;
+      if constexpr (Model::Rolling::kActive) {
+        ti += out.rolling.torque;
+        tj -= out.rolling.torque;
+        diss += out.rolling.dissipated;
+        el += out.rolling.elastic;
+      }
+      Pack ratio = kin.delta / vmin(ri, rj);
+      if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
+        ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
+      put_pack(c, n, {fx, fy, ti, tj, diss, el, ratio, -cf.f_el * nx, -cf.f_el * ny}, dissipated,
+               elastic, overlap);
+    }
+  }
+}
+
+// A pack's outputs into the batch, and its energies and overlap into the chunk's sums. Padding
+// lanes repeat the last contact, and lanes this rank does not count are another rank's: both are
+// kept out of the sums.
+template <class Model, class Shape>
+[[gnu::always_inline]] inline void Kernel<Model, Shape>::put_pack(std::size_t c, std::size_t n,
+                                                                  const PackOut& o,
+                                                                  EightLanes& dissipated,
+                                                                  EightLanes& elastic,
+                                                                  Pack& overlap) {
+  const PackMask real =
+      Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
+      load(b_.counted, c) > 0.5;
+  dissipated.add(c, select(real, o.diss, Pack(0.0)));
+  elastic.add(c, select(real, o.el, Pack(0.0)));
+  overlap = vmax(overlap, o.ratio);
+  store(o.fx, b_.fx, c);
+  store(o.fy, b_.fy, c);
+  store(o.ti, b_.t_i, c);
+  store(o.tj, b_.t_j, c);
+  store(o.ratio, b_.overlap, c);
+  store(o.ex, b_.ex, c);
+  store(o.ey, b_.ey, c);
+}
+
+// B for a shape whose arms leave the normal: its narrow phase reads and advances its own history
+// slots; the surface velocities are v + w x arm and the torques arm x force; the lanes whose
+// bounding circles overlap while the bodies do not are zeroed (force, energies, history) and
+// uncounted.
+template <class Model, class Shape>
+void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightLanes& dissipated,
+                                                EightLanes& elastic, Pack& overlap) {
+  const Pack zero(0.0);
   for (std::size_t c = 0; c < padded(n); c += kPackSize) {
     const Pack ri = load(b_.r_i, c), rj = load(b_.r_j, c);
+    std::array<Pack, kShapeWidth> h_old, h_new;
+    for (std::size_t s = 0; s < kShapeWidth; ++s)
+      h_old[s] = load(b_.history.old[kModelWidth + s], c);
     const PairContactT<Pack> g =
-        Shape::pair(load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj);
+        Shape::pair(PairInputT<Pack>{load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj,
+                                     load(b_.th_i, c), load(b_.th_j, c)},
+                    h_old, h_new);
+    const PackMask touching = g.delta > zero;
+    store(select(touching, load(b_.counted, c), zero), b_.counted, c);
     const Pack nx = g.nx, ny = g.ny;
     const Pack tx = -ny, ty = nx;
     const Pack mi = load(b_.m_i, c), mj = load(b_.m_j, c);
@@ -151,51 +241,44 @@ void Kernel<Model>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipa
     kin.r_eff = g.r_eff;
     kin.m_eff = mi * mj / (mi + mj);
     if constexpr (Model::Rolling::kNeedsInertia) {
-      // About the contact point; harmonic mean of the two bodies.
       const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
       kin.i_eff = ia * ib / (ia + ib);
     }
-    const Pack spin = load(b_.spin, c);
-    project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
+    // (v_i + w_i x a_i) - (v_j + w_j x a_j), with w x a = w (-a_y, a_x).
+    const Pack wi = load(b_.w_i, c), wj = load(b_.w_j, c);
+    project_velocity(kin, load(b_.vx, c) - wi * g.aiy + wj * g.ajy,
+                     load(b_.vy, c) + wi * g.aix - wj * g.ajx, nx, ny);
     kin.omega_rel = load(b_.omega_rel, c);
     const ContactResponseT<Pack> out = respond(b_, c, kin, dt);
+    for (std::size_t s = 0; s < kModelWidth; ++s)
+      store(select(touching, load(b_.history.fresh[s], c), zero), b_.history.fresh[s], c);
+    for (std::size_t s = 0; s < kShapeWidth; ++s)
+      store(select(touching, h_new[s], zero), b_.history.fresh[kModelWidth + s], c);
     const ContactForceT<Pack>& cf = out.law;
-    const Pack fx = cf.f_t * tx - cf.f_n * nx, fy = cf.f_t * ty - cf.f_n * ny;
-    // Arms along the normal (Shape::kArmsAlongNormal): arm x force = arm f_t.
-    const Pack arm_i = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_i;
-    const Pack arm_j = Model::Law::kTorqueArmIsReff ? kin.r_eff : g.arm_j;
-    Pack ti = arm_i * cf.f_t, tj = arm_j * cf.f_t;
+    const Pack fx = select(touching, cf.f_t * tx - cf.f_n * nx, zero);
+    const Pack fy = select(touching, cf.f_t * ty - cf.f_n * ny, zero);
+    // On i: a_i x F; on j: a_j x (-F).
+    Pack ti = g.aix * fy - g.aiy * fx, tj = g.ajy * fx - g.ajx * fy;
     Pack diss = cf.dissipated, el = cf.elastic;
     if constexpr (Model::Rolling::kActive) {
-      ti += out.rolling.torque;
-      tj -= out.rolling.torque;
+      ti += select(touching, out.rolling.torque, zero);
+      tj -= select(touching, out.rolling.torque, zero);
       diss += out.rolling.dissipated;
       el += out.rolling.elastic;
     }
     Pack ratio = kin.delta / vmin(ri, rj);
-    if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
-      ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
-    // Padding lanes repeat the last contact: keep them out of the sums.
-    const PackMask real =
-        Pack([&](auto l) { return static_cast<double>(c + l); }) < static_cast<double>(n) &&
-        load(b_.counted, c) > 0.5;
-    dissipated.add(c, select(real, diss, Pack(0.0)));
-    elastic.add(c, select(real, el, Pack(0.0)));
-    overlap = vmax(overlap, ratio);
-    store(fx, b_.fx, c);
-    store(fy, b_.fy, c);
-    store(ti, b_.t_i, c);
-    store(tj, b_.t_j, c);
-    store(ratio, b_.overlap, c);
-    store(-cf.f_el * nx, b_.ex, c);
-    store(-cf.f_el * ny, b_.ey, c);
+    if constexpr (Model::Tracker::kExcludes) ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
+    const Pack f_el = select(touching, cf.f_el, zero);
+    put_pack(c, n,
+             {fx, fy, ti, tj, diss, el, select(touching, ratio, zero), -f_el * nx, -f_el * ny},
+             dissipated, elastic, overlap);
   }
 }
 
 // C. Scatter in canonical pair order; or, with the list in storage order, the two force records
 // of each contact (sum_records adds them up in canonical order).
-template <class Model>
-void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n) {
   if (!pl.canonical()) return write_records(pl, n);
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
@@ -231,8 +314,8 @@ void Kernel<Model>::scatter_pairs(ParticleStore& p, PairList& pl, std::size_t n)
 
 // The chunk's contacts whose breakage test is due, by their new histories (the values the
 // commit makes the committed ones), in list order.
-template <class Model>
-void Kernel<Model>::note_tests_due(std::size_t n) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::note_tests_due(std::size_t n) {
   constexpr std::size_t kTracker = Model::kLawSlots + Model::kRollingSlots;
   const double* peak = b_.history.fresh[kTracker + TrackBreakage::kPeak].data();
   const double* energy = b_.history.fresh[kTracker + TrackBreakage::kEnergy].data();
@@ -241,8 +324,8 @@ void Kernel<Model>::note_tests_due(std::size_t n) {
     if (TrackBreakage::test_due(peak[c], energy[c], tested[c])) tests_due_.push_back(b_.pair[c]);
 }
 
-template <class Model>
-void Kernel<Model>::write_records(PairList& pl, std::size_t n) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::write_records(PairList& pl, std::size_t n) {
   double* trial = new_histories(pl);
   ForceRecord* rec = records_.data();
   for (std::size_t c = 0; c < n; ++c) {
@@ -256,8 +339,8 @@ void Kernel<Model>::write_records(PairList& pl, std::size_t n) {
 // Each owned particle's pair forces added in the order of its partners' ids, as the canonical
 // scatter adds them (f - g and f + (-g) are the same number); the records of candidates not in
 // contact are passed over (they hold an earlier evaluation's values).
-template <class Model>
-void Kernel<Model>::sum_records(ParticleStore& p, const PairList& pl) {
+template <class Model, class Shape>
+void Kernel<Model, Shape>::sum_records(ParticleStore& p, const PairList& pl) {
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();

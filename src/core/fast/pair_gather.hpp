@@ -57,6 +57,13 @@ struct GatherColumns {
   double* spin;
   double* omega_rel;
   double* const* old;  // `width` columns
+  // For a shape whose arms leave the normal (gather_frames_scalar), else null: the angles, and
+  // each body's spin and angle in the batch.
+  const double* theta = nullptr;
+  double* w_i = nullptr;
+  double* w_j = nullptr;
+  double* th_i = nullptr;
+  double* th_j = nullptr;
 };
 
 // The candidates [k0, k1) in contact, packed into the columns from 0 on; returns their count.
@@ -101,6 +108,17 @@ inline void gather_inputs_scalar(const GatherColumns& o, std::size_t c0, std::si
     o.spin[c] = o.w[i] * o.r[i] + o.w[j] * o.r[j];
     o.omega_rel[c] = o.w[i] - o.w[j];
     for (std::size_t s = 0; s < o.width; ++s) o.old[s][c] = o.history[k * o.width + s];
+  }
+}
+
+// Each body's spin and angle of contacts [c0, c1), for a shape whose arms leave the normal.
+inline void gather_frames_scalar(const GatherColumns& o, std::size_t c0, std::size_t c1) {
+  for (std::size_t c = c0; c < c1; ++c) {
+    const std::int32_t i = o.bi[c], j = o.bj[c];
+    o.w_i[c] = o.w[i];
+    o.w_j[c] = o.w[j];
+    o.th_i[c] = o.theta[i];
+    o.th_j[c] = o.theta[j];
   }
 }
 

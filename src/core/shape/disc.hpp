@@ -11,13 +11,18 @@
 // Contact arms: the contact point seen from each centre. A disc's arms lie along the normal (from
 // i: +arm_i n, from j: -arm_j n), so the torque of a force f_t t - f_n n about its centre is
 // arm f_t exactly as arm x force, and the velocity of its surface point is v + w arm t: the force
-// kernel takes those forms for a shape with kArmsAlongNormal.
+// kernel takes those forms for a shape with kArmsAlongNormal. A shape whose arms leave the normal
+// (kArmsAlongNormal = false) returns them as vectors, and the kernel takes arm x force and
+// v + w x arm; such a shape may also keep history of its own in each contact (kHistory, after
+// the contact model's slots). docs/extending.md, "A particle shape", lists what it declares.
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
+#include "core/base/history_slot.hpp"
 #include "core/base/vec2.hpp"
 #include "core/geometry/walls.hpp"
 
@@ -29,7 +34,19 @@ struct PairContactT {
   T delta;         // overlap (> 0 in contact)
   T nx, ny;        // unit normal from i towards j
   T r_eff;         // effective radius of curvature at the contact (Hertz R*)
-  T arm_i, arm_j;  // lengths of the contact arms (along the normal for a disc)
+  T arm_i, arm_j;  // lengths of the contact arms along the normal (kArmsAlongNormal)
+  // The arms as vectors, contact point minus each centre (shapes without kArmsAlongNormal).
+  T aix{}, aiy{}, ajx{}, ajy{};
+};
+
+// What the narrow phase of a shape without kArmsAlongNormal reads for two bodies i and j: the
+// centres' offset d = x_j - x_i (dist2 = |d|^2), their radii (bounding circles: the broad phase
+// and the gather's first test use them) and their angles.
+template <class T>
+struct PairInputT {
+  T dx, dy, dist2;
+  T ri, rj;
+  T th_i, th_j;
 };
 
 // Closest contact of a body with one wall element at the current time.
@@ -39,8 +56,17 @@ struct WallGeometry {
   Vec2 point{};        // contact point on the wall
 };
 
+// A shape without kArmsAlongNormal against a wall element: the geometry, the arm (contact point
+// minus centre) and the radius of curvature at the contact (Hertz R* against a flat wall).
+struct WallContact {
+  WallGeometry g;
+  Vec2 arm{};
+  double r_eff = 0.0;
+};
+
 struct Disc {
   static constexpr bool kArmsAlongNormal = true;
+  static constexpr std::array<HistorySlot, 0> kHistory{};  // none of its own
 
   static double mass(double r, double density) {
     return 4.0 / 3.0 * std::numbers::pi * r * r * r * density;
