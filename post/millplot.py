@@ -82,9 +82,12 @@ def deck_of(run):
 
 
 def run_title(run, fallback):
-    """The deck's title from run.json, else `fallback`."""
+    """The deck's title from run.json, else `fallback`; the run's --set options after it, in
+    brackets (the title is the deck's, the run may differ from it)."""
     title = deck_of(run).get("title")
-    return str(title) if title else fallback
+    title = str(title) if title else fallback
+    overrides = run.get("overrides") or []
+    return f"{title} [{', '.join(map(str, overrides))}]" if overrides else title
 
 
 def analysis_window(run, default=1.0):

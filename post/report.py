@@ -14,8 +14,8 @@ writes into REPORTDIR (default OUTDIR/report):
   charge_TTT.TTTs.png the charge at a few snapshot times (evenly spaced, the last included):
                       particles at their true radius coloured by speed [m/s], drum and lifters;
   collisions.png      collision energy spectra per contact type (when collisions.csv exists);
-  charge.mp4          an animation of the charge (when ffmpeg is on the PATH; at most
-                      --max-frames frames, default 200);
+  charge.mp4          an animation of the charge (at most --max-frames frames, default 200);
+                      charge.gif instead when ffmpeg is not on the PATH;
   report.md, index.html  the list of files with a caption each, and the run's key numbers:
                       critical speed, fraction of critical, regime, average power, its scaling
                       to a mill (the 2D power is that of a slice one ball diameter thick).
@@ -330,9 +330,10 @@ def animation_frames(names, max_frames):
 
 
 def write_animation(run, f, names, vmax, path, max_frames):
-    """charge.mp4 through matplotlib's FFMpegWriter; returns the number of frames. The layout
-    is fixed and the axes bare, so that a frame costs only the drawing of the particles."""
-    from matplotlib.animation import FFMpegWriter  # noqa: PLC0415
+    """The animation through matplotlib's FFMpegWriter (path ending .mp4) or, without ffmpeg,
+    its PillowWriter (.gif); returns the number of frames. The layout is fixed and the axes
+    bare, so that a frame costs only the drawing of the particles."""
+    from matplotlib.animation import FFMpegWriter, PillowWriter  # noqa: PLC0415
     from matplotlib.collections import LineCollection  # noqa: PLC0415
 
     frames = animation_frames(names, max_frames)
@@ -352,8 +353,11 @@ def write_animation(run, f, names, vmax, path, max_frames):
     ax.set_xlim(*xlim)
     ax.set_ylim(*ylim)
     circles = None
-    writer = FFMpegWriter(fps=fps, metadata={"title": run.title}, bitrate=2000,
-                          extra_args=["-pix_fmt", "yuv420p"])
+    if path.endswith(".gif"):
+        writer = PillowWriter(fps=fps, metadata={"title": run.title})
+    else:
+        writer = FFMpegWriter(fps=fps, metadata={"title": run.title}, bitrate=2000,
+                              extra_args=["-pix_fmt", "yuv420p"])
     with writer.saving(fig, path, dpi=100):
         for name in frames:
             snap = millplot.read_snapshot(f, name)
@@ -470,6 +474,9 @@ def write_html(path, run, numbers, files):
         if name.endswith(".png"):
             parts.append(f"<h3>{e(name)}</h3><p>{e(caption)}</p><img src='{e(name)}' "
                          "style='max-width:100%'>")
+        elif name.endswith(".gif"):
+            parts.append(f"<h3>{e(name)}</h3><p>{e(caption)}</p><img src='{e(name)}' "
+                         "style='max-width:100%'>")
         elif name.endswith(".mp4"):
             parts.append(f"<h3>{e(name)}</h3><video src='{e(name)}' controls "
                          "style='max-width:100%'></video>")
@@ -498,17 +505,17 @@ def snapshot_pictures(run, reportdir, args, files):
                           f"(0-{vmax:.3g} m/s), {walls}"))
         if args.no_animation:
             return
-        if shutil.which("ffmpeg") is None:
-            print("report.py: ffmpeg is not on the PATH: no animation (charge.mp4) written")
-            return
-        frames = write_animation(run, f, names, vmax, os.path.join(reportdir, "charge.mp4"),
+        movie = "charge.mp4" if shutil.which("ffmpeg") else "charge.gif"
+        if movie.endswith(".gif"):
+            print("report.py: ffmpeg is not on the PATH: the animation is a GIF (charge.gif)")
+        frames = write_animation(run, f, names, vmax, os.path.join(reportdir, movie),
                                  args.max_frames)
-        files.append(("charge.mp4", f"animation of the charge coloured by speed, {frames} "
+        files.append((movie, f"animation of the charge coloured by speed, {frames} "
                       f"frames from {len(names)} snapshots"))
 
 
 REPORT_FILES = re.compile(r"^(energies|power|charge_shape|collisions|charge_\d+\.\d+s)\.png$"
-                          r"|^(charge\.mp4|report\.md|index\.html)$")
+                          r"|^(charge\.mp4|charge\.gif|report\.md|index\.html)$")
 
 
 def remove_stale(reportdir):

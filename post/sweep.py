@@ -144,7 +144,7 @@ def summarise(folder, fraction, exit_status):
         speed = fraction * wc
     row = {"fraction": fraction, "speed_rad_s": speed if speed is not None else math.nan,
            "power_W": math.nan, "power_std_W": math.nan, "regime": "failed",
-           "power_per_metre_W": math.nan, "critical": wc, "title": millplot.run_title(run, "")}
+           "power_per_metre_W": math.nan, "critical": wc, "title": str(deck.get("title") or "")}
     row["speed_rpm"] = row["speed_rad_s"] * millplot.RPM_PER_RAD_S
     series_path = os.path.join(folder, "series.csv")
     if exit_status != 0 or not os.path.exists(series_path):
@@ -274,6 +274,8 @@ def main(argv=None):
     rows = [summarise(run_folder(args.output, f), f, status[f]) for f in args.fractions]
     write_csv(os.path.join(args.output, "sweep.csv"), rows)
     title = next((r["title"] for r in rows if r["title"]), os.path.basename(args.deck))
+    if args.set:  # the overrides every run shares (each run's speed is the x axis)
+        title += f" [{', '.join(args.set)}]"
     plot(os.path.join(args.output, "power_vs_speed.png"), rows, title, args.duration)
     print_table(rows)
     failed = [f for f in args.fractions if status[f] != 0]

@@ -139,7 +139,7 @@ int run(const Options& opt) {
   if (opt.check) {
     // Every rank evaluates the whole scene alike; rank 0 prints.
     const Simulation whole(scene);
-    say(check_report(whole));
+    say(check_report(whole, timed_trial(scene)));
     return kExitOk;
   }
   MpiDomain domain(MPI_COMM_WORLD, decomposition_of(scene));
@@ -156,17 +156,21 @@ int run(const Options& opt) {
         " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
         (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory +
         (resumed ? fmt_double(", continued from t = %.6g s", sim.time()) : "") + "\n");
+  if (is_ore_scene(scene) && !scene.sieve.present)
+    say(scene.deck_path + ": note: no [sieve]: nothing leaves the mill, " + kProductFile +
+        " keeps only its header\n");
 
   Progress progress(opt.quiet, scene.run.duration, out.progress_interval, sim.step_count());
   const auto start = Clock::now();
   const std::int64_t first_step = sim.step_count();
   RunLoop loop(sim, scene, domain, series, *snapshots, resumed);
-  const Ending ending = loop.run(progress, n_global);
+  const Ending ending = loop.run(progress);
   if (ending == Ending::kUnstable) return kExitUnstable;
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   const RunInfo info = run_info(
       sim, domain, scene,
-      {n_global, wall, sim.step_count() - first_step, ending == Ending::kInterrupted, opt.restart});
+      {n_global, loop.particles(), loop.particle_steps(), wall, sim.step_count() - first_step,
+       ending == Ending::kInterrupted, opt.restart, opt.sets});
   if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
   if (!opt.quiet && ending == Ending::kFinished)
     say(fmt_double("done: %.4g s simulated", sim.time()) +

@@ -1,15 +1,23 @@
 #include "io/check_report.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
+#include "core/base/errors.hpp"
 #include "core/mill/mill_analytics.hpp"
+#include "core/step/time_scales.hpp"
 #include "io/text.hpp"
 
 namespace dem2d {
 
 namespace {
+
+// How much longer a step of a settled charge takes than one of the first steps (the fill still
+// falling, few contacts): measured on the shipped drum decks (docs/input.md, "--check").
+constexpr double kSettledCostFactor = 2.0;
 
 // The mill's numbers.
 std::string mill_check_lines(const Scene& s, const MillNumbers& m) {
@@ -30,9 +38,73 @@ std::string mill_check_lines(const Scene& s, const MillNumbers& m) {
   return out;
 }
 
+// What sets the time step, and how much larger it would be without the smallest restitution.
+std::string dt_driver_lines(const TimeScales& ts) {
+  std::string out = "  dt set by:             the shortest contact, " + ts.hertz_pair;
+  if (ts.steps_per_contact > steps_per_contact_for(1.0))
+    out += fmt_double(", resolved with %.0f steps for", ts.steps_per_contact) +
+           fmt_double(" the restitution %.3f of ", ts.restitution_min) + ts.restitution_pair +
+           fmt_double(" (%.3g times as many as a restitution of 0.7 or more needs)",
+                      ts.steps_per_contact / steps_per_contact_for(1.0));
+  return out + "\n";
+}
+
+// The run's wall time on one rank from the trial's rate.
+std::string wall_time_line(const Trial& trial, double particle_steps) {
+  if (trial.particle_steps_per_second <= 0.0)
+    return "  wall time estimate:    none (" +
+           (trial.stopped.empty() ? std::string("the trial took no step") : trial.stopped) + ")\n";
+  return fmt_double("  wall time estimate:    %.3g s on 1 rank",
+                    particle_steps / trial.particle_steps_per_second) +
+         fmt_double(" (%.3g particle-steps/s", trial.particle_steps_per_second) +
+         fmt_double(" over the first %.0f steps", static_cast<double>(trial.steps)) +
+         "; a settled charge has more contacts per particle than the start: up to " +
+         fmt_double("%.1fx as long", kSettledCostFactor) + ")\n";
+}
+
+// When ore starts to break, and whether the fill is still falling then: the free fall of its
+// highest particle to the lowest point of the shell.
+std::string breakage_line(const Scene& s, const ParticleStore& p) {
+  std::string out =
+      fmt_double("  breakage from:         t = %.4g s (breakage.start)", s.breakage.start);
+  const double g = norm(s.run.gravity);
+  if (!s.drum.present || g <= 0.0 || p.n_owned() == 0) return out + "\n";
+  double top = -std::numeric_limits<double>::max();
+  for (std::size_t k = 0; k < p.n_owned(); ++k) top = std::max(top, p.pos[k].y + p.radius[k]);
+  const double fall = std::sqrt(2.0 * std::max(0.0, top - (s.drum.center.y - s.drum.radius)) / g);
+  if (s.breakage.start < fall)
+    out += fmt_double("; the fill falls until about %.2g s (its highest particle to the shell):",
+                      fall) +
+           " ore hit before the charge settles breaks in the fall; set breakage.start later to "
+           "break ore in the tumbling charge only";
+  return out + "\n";
+}
+
 }  // namespace
 
-std::string check_report(const Simulation& sim) {
+Trial timed_trial(const Scene& scene, double budget_seconds) {
+  using Clock = std::chrono::steady_clock;
+  Trial trial;
+  Simulation sim(scene);
+  const auto start = Clock::now();
+  double particle_steps = 0.0;
+  try {
+    while (sim.time() + 0.5 * sim.dt() < scene.run.duration &&
+           std::chrono::duration<double>(Clock::now() - start).count() < budget_seconds) {
+      sim.step(true);
+      particle_steps += static_cast<double>(sim.particles().n_owned());
+      ++trial.steps;
+    }
+  } catch (const UnstableError& e) {
+    trial.stopped = std::string("the trial stopped: ") + e.what();
+  }
+  trial.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (trial.steps > 0 && trial.seconds > 0.0)
+    trial.particle_steps_per_second = particle_steps / trial.seconds;
+  return trial;
+}
+
+std::string check_report(const Simulation& sim, const Trial& trial) {
   const Scene& s = sim.scene();
   const ParticleStore& p = sim.particles();
   const TimeScales& ts = sim.scales();
@@ -45,6 +117,7 @@ std::string check_report(const Simulation& sim) {
     r_max = std::max(r_max, p.radius[k]);
   }
   if (s.drum.present) out += mill_check_lines(s, mill_numbers(s, area, r_max));
+  if (s.breakage.present) out += breakage_line(s, p);
   out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);
@@ -53,11 +126,13 @@ std::string check_report(const Simulation& sim) {
                     ts.steps_per_contact);
   out += fmt_double("  safe dt:               %.4e s (dt = \"auto\")", ts.safe_dt) +
          fmt_double("; refused above %.4e s\n", ts.limit_dt);
+  out += dt_driver_lines(ts);
   out += fmt_double("  chosen dt:             %.4e s", sim.dt()) +
          fmt_double(" (%.3f of the safe dt)\n", sim.dt() / ts.safe_dt);
   const double steps = std::ceil(s.run.duration / sim.dt() - 0.5);
   out += fmt_double("  steps:                 %.0f", steps) +
          fmt_double(" for %.4g s simulated\n", s.run.duration);
+  out += wall_time_line(trial, steps * static_cast<double>(p.n_owned()));
   const double bytes =
       static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);

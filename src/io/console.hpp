@@ -14,8 +14,9 @@ namespace dem2d {
 // Writes `text` to `stream` on rank 0 of MPI_COMM_WORLD and flushes it; nothing elsewhere.
 void say(const std::string& text, FILE* stream = stdout);
 
-// The progress line on stderr (rank 0, unless quiet): step, time, particles, particle-steps
-// per second and the time left. On a terminal one line rewritten at most every 0.5 s; else a
+// The progress line on stderr (rank 0, unless quiet): step, time, particles now, particle-steps
+// per second (the particle count of every step summed, births and discharges included) and the
+// time left. On a terminal one line rewritten at most every 0.5 s; else a
 // line every `interval` seconds of wall time.
 class Progress {
  public:
@@ -23,7 +24,9 @@ class Progress {
   // `first_step`: the step the run starts from (a restart continues the count).
   Progress(bool quiet, double duration, double interval, std::int64_t first_step);
   // `final_line`: the run's last line, written whatever the time since the previous one.
-  void update(const Simulation& sim, std::int64_t n_particles, bool final_line = false);
+  // `particles`: over every rank now; `particle_steps`: since the run started here.
+  void update(const Simulation& sim, std::int64_t particles, double particle_steps,
+              bool final_line = false);
 
  private:
   std::int64_t first_step_;

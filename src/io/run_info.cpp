@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numbers>
 
+#include "core/mill/grinding.hpp"
 #include "core/mill/mill_analytics.hpp"
 #include "io/text.hpp"
 
@@ -47,6 +48,36 @@ JsonObject mill_json(const Simulation& sim, const MpiDomain& domain) {
   return mill;
 }
 
+// Collective: the mass of every particle in the mill (balls and ore), kg per slice.
+double charge_mass(const Simulation& sim, const MpiDomain& domain) {
+  const ParticleStore& p = sim.particles();
+  double mass = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) mass += p.mass[k];
+  return domain.sum(mass);
+}
+
+// run.json's "ore" object: what was fed, broken and let out since the start, and the product
+// rate (the mass the sieve let out over the simulated time; 0 without a [sieve], which
+// `sieve` says).
+JsonObject ore_json(const Simulation& sim, const Scene& scene) {
+  JsonObject ore;
+  const Grinding* g = sim.grinding();
+  const GrindingTotals t = g ? g->totals() : GrindingTotals{};
+  const double hours = sim.time() / 3600.0;
+  ore.add("sieve", scene.sieve.present ? "true" : "false")
+      .add_integer("fed_count", t.fed_count)
+      .add_number("fed_mass_kg", t.fed_mass, "%.10g")
+      .add_integer("breakages", t.breakages)
+      .add_integer("fragments", t.fragments)
+      .add_integer("discharged_count", t.discharged_count)
+      .add_number("discharged_mass_kg", t.discharged_mass, "%.10g")
+      .add_number("product_rate_kg_s", sim.time() > 0 ? t.discharged_mass / sim.time() : 0.0,
+                  "%.10g")
+      .add_number("product_rate_t_h", hours > 0 ? t.discharged_mass / 1000.0 / hours : 0.0,
+                  "%.10g");
+  return ore;
+}
+
 // The decomposition: per-rank work (owned particles + listed pairs at the last rebuild),
 // ghosts, migrations and time in communication; the imbalance against equal angles.
 void add_decomposition(JsonObject& extra, const MpiDomain& domain) {
@@ -73,11 +104,14 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   info.wall_time_s = facts.wall;
   info.steps = sim.step_count();
   info.particle_steps_per_second =
-      facts.wall > 0
-          ? static_cast<double>(facts.n_global) * static_cast<double>(facts.steps_here) / facts.wall
-          : 0.0;
+      facts.wall > 0 ? static_cast<double>(facts.particle_steps) / facts.wall : 0.0;
   info.dt = sim.dt();
   JsonObject& extra = info.extra;
+  extra.add_integer("particles", facts.particles)
+      .add_integer("particles_at_start", facts.particles_at_start)
+      .add_integer("particle_steps", facts.particle_steps)
+      .add_number("charge_mass_kg", charge_mass(sim, domain), "%.10g");
+  if (is_ore_scene(scene)) extra.add("ore", ore_json(sim, scene).inline_text());
   extra.add_integer("neighbor_builds", sim.neighbor_builds());
   if (scene.run.integrator == IntegratorKind::kIterative) {
     extra.add_number("mean_passes",
@@ -94,6 +128,10 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   extra.add("interrupted", facts.interrupted ? "true" : "false");
   extra.add("restarted_from",
             facts.restarted_from.empty() ? "null" : quoted_string(facts.restarted_from));
+  std::string sets;
+  for (const std::string& s : facts.overrides)
+    sets += (sets.empty() ? "" : ", ") + quoted_string(s);
+  extra.add("overrides", "[" + sets + "]");
   return info;
 }
 

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/run/simulation.hpp"
 #include "io/run_json.hpp"
@@ -13,11 +14,14 @@
 namespace dem2d {
 
 struct RunFacts {
-  std::int64_t n_global = 0;    // particles over every rank
-  double wall = 0.0;            // s of wall time of the run loop
+  std::int64_t particles_at_start = 0;  // over every rank, when this run started
+  std::int64_t particles = 0;           // over every rank, at the end
+  std::int64_t particle_steps = 0;      // each step's particle count, summed over this run
+  double wall = 0.0;                    // s of wall time of the run loop
   std::int64_t steps_here = 0;  // the steps this process took (a restart continues the count)
   bool interrupted = false;     // stopped by SIGINT or SIGTERM
   std::string restarted_from;   // the checkpoint continued (--restart), empty for a new run
+  std::vector<std::string> overrides;  // the --set options, in order
 };
 
 // Collective (the decomposition's per-rank figures and the mill's totals are gathered).

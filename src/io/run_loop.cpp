@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <span>
 #include <string>
 
 #include "core/base/errors.hpp"
@@ -72,8 +73,24 @@ void RunLoop::checkpoint() {
   checkpoint_step_ = sim_.step_count();
 }
 
-Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
+void RunLoop::count_particles() {
+  std::int64_t counts[2] = {static_cast<std::int64_t>(sim_.particles().n_owned()),
+                            local_particle_steps_};
+  domain_.sum(std::span<std::int64_t>(counts));
+  particles_ = counts[0];
+  particle_steps_ = counts[1];
+  counted_at_step_ = sim_.step_count();
+}
+
+double RunLoop::particle_steps_now() const {
+  return static_cast<double>(particle_steps_) +
+         static_cast<double>(particles_) *
+             static_cast<double>(sim_.step_count() - counted_at_step_);
+}
+
+Ending RunLoop::run(Progress& progress) {
   const OutputSpec& out = scene_.output;
+  count_particles();
   if (!resumed_) {
     series_.write(sim_.record_row());
     sim_.reset_pass_window();
@@ -82,9 +99,13 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
   try {
     while (sim_.time() + 0.5 * sim_.dt() < scene_.run.duration) {
       sim_.step(observes_step(sim_.step_count() + 1));
+      local_particle_steps_ += static_cast<std::int64_t>(sim_.particles().n_owned());
       after_step();
-      if (polls_at(sim_.step_count()) && stop_requested()) return finish(Ending::kInterrupted);
-      progress.update(sim_, n_global);
+      if (polls_at(sim_.step_count())) {
+        count_particles();
+        if (stop_requested()) return finish(Ending::kInterrupted);
+      }
+      progress.update(sim_, particles_, particle_steps_now());
     }
   } catch (const UnstableError& e) {
     ore_.write(sim_);
@@ -94,8 +115,9 @@ Ending RunLoop::run(Progress& progress, std::int64_t n_global) {
         stderr);
     return Ending::kUnstable;
   }
-  progress.update(sim_, n_global, true);
-  return finish(Ending::kFinished);
+  const Ending ending = finish(Ending::kFinished);
+  progress.update(sim_, particles_, static_cast<double>(particle_steps_), true);
+  return ending;
 }
 
 void RunLoop::after_step() {
@@ -129,6 +151,7 @@ bool RunLoop::stop_requested() {
 // interrupted: the restart writes the rows from here on, as the whole run would have), the
 // logs, and the checkpoint, always.
 Ending RunLoop::finish(Ending ending) {
+  count_particles();
   if (last_snapshot_time_ != sim_.time()) snapshot();
   if (ending == Ending::kFinished && !due_at(sim_.time()).series) series_.write(sim_.record_row());
   if (checkpoint_step_ != sim_.step_count()) checkpoint();

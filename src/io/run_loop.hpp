@@ -32,9 +32,14 @@ class RunLoop {
           SnapshotWriter& snapshots, bool resumed);
   // Collective: steps to run.duration or until stopped. kUnstable: an UnstableError, told on
   // stderr after the last snapshot was written.
-  Ending run(Progress& progress, std::int64_t n_global);
+  Ending run(Progress& progress);
   // The signal that stopped the run (kInterrupted).
   int stop_signal() const { return stop_signal_; }
+  // Over every rank: the particles now and the particle-steps taken by this run (each step's
+  // count of owned particles summed; a restart counts from where it continued). Exact after
+  // run() returns, as of the last poll while it runs.
+  std::int64_t particles() const { return particles_; }
+  std::int64_t particle_steps() const { return particle_steps_; }
 
  private:
   // The outputs due at time t: one test for the step that acts on them (after_step, finish)
@@ -54,6 +59,11 @@ class RunLoop {
   void after_step();
   // The poll: a stop signal on any rank, and rank 0's clock for output.checkpoint_minutes.
   bool stop_requested();
+  // Collective: particles() and particle_steps() from every rank's counts.
+  void count_particles();
+  // The particle-steps for the progress line: exact at the last poll, the count then for the
+  // steps since.
+  double particle_steps_now() const;
   Ending finish(Ending ending);
 
   Simulation& sim_;
@@ -68,6 +78,8 @@ class RunLoop {
   std::int64_t checkpoint_step_ = -1;  // the step of the last checkpoint written
   std::size_t guards_told_ = 0;        // run.guards = "warn": each kind is told when it first fires
   int stop_signal_ = 0;
+  std::int64_t local_particle_steps_ = 0;  // this rank's owned particles summed over the steps
+  std::int64_t particles_ = 0, particle_steps_ = 0, counted_at_step_ = 0;
 };
 
 }  // namespace dem2d

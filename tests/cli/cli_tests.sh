@@ -61,6 +61,25 @@ m0 = float(rows[0]['mill_mass']); last = rows[-1]
 worst = max(abs(m0 + float(r['fed_mass']) - float(r['mill_mass']) - float(r['discharged_mass'])) for r in rows)
 ok = int(last['breakages']) > 20 and int(last['fed_count']) >= 3 and int(last['discharged_count']) > 0 and worst < 1e-11 * m0
 print('ok' if ok else 'bad', last['breakages'], last['fed_count'], last['discharged_count'], worst)"
+  # run.json counts what the run held: the particles born by breakage and feed, the charge's
+  # mass and the product rate as the series has them, the same particle-steps on any rank count.
+  expect "grinding run.json counts" 0 'ok' -- /usr/bin/python3 -c "
+import csv, json
+runs = [json.load(open(f'$tmp/gr{np}/run.json')) for np in (1, 2, 3)]
+rows = list(csv.DictReader(open('$tmp/gr1/series.csv')))
+first, last, j = rows[0], rows[-1], runs[0]
+ps = [r['particle_steps'] for r in runs]
+steps, t = j['steps'], float(last['time'])
+ore = j['ore']
+ok = (j['particles'] == int(last['particles']) > j['particles_at_start'] == int(first['particles'])
+      and ps[0] == ps[1] == ps[2] and j['particles_at_start'] * steps < ps[0] < j['particles'] * steps
+      and abs(j['particle_steps_per_second'] * j['wall_time_s'] - ps[0]) < 1e-6 * ps[0]
+      and abs(j['charge_mass_kg'] - float(last['mill_mass'])) < 1e-9 * j['charge_mass_kg']
+      and ore['sieve'] and float(last['discharged_mass']) > 0
+      and abs(ore['discharged_mass_kg'] - float(last['discharged_mass'])) < 1e-9 * ore['discharged_mass_kg']
+      and abs(ore['product_rate_kg_s'] - ore['discharged_mass_kg'] / t) < 1e-9 * ore['product_rate_kg_s']
+      and abs(ore['product_rate_t_h'] - 3.6 * ore['product_rate_kg_s']) < 1e-9 * ore['product_rate_t_h'])
+print('ok' if ok else 'bad', j['particles_at_start'], j['particles'], ps, ore)"
 }
 
 # bad_input NP: bad options and bad decks on NP ranks: exit 2 and the message.

@@ -40,6 +40,19 @@ expect "check bed filling" 0 'bed filling J: +0\.457' -- "$dem2d" --check "$wf"
 expect "check T37" 0 'with fill \(thesis T37\) 2\.2360 rad/s' -- "$dem2d" --check "$wf"
 expect "check slice" 0 '2D to 3D: +the slice is 0\.2 m thick' -- "$dem2d" --check "$wf"
 
+# --check names what sets dt, estimates the wall time from a trial, and says when ore breaks
+# while the fill still falls.
+gr=$src/inputs/grinding.in
+expect "check dt set by the shortest contact" 0 'dt set by: +the shortest contact, ore against a wall of steel$' -- \
+  "$dem2d" --check "$gr"
+expect "check dt set by a small restitution" 0 'dt set by: .*resolved with 4[0-9]{2} steps for the restitution 0\.100 of ore against ore \(2[01](\.[0-9]+)? times as many as a restitution of 0\.7 or more needs\)' -- \
+  "$dem2d" --check --set material.ore.restitution=0.1 "$gr"
+expect "check wall time estimate" 0 'wall time estimate: +[0-9.e+]+ s on 1 rank \([0-9.e+]+ particle-steps/s over the first [0-9]+ steps' -- \
+  "$dem2d" --check "$wf"
+expect "check breakage while the fill falls" 0 'breakage from: +t = 0 s \(breakage\.start\); the fill falls until about 0\.66 s' -- \
+  "$dem2d" --check --set breakage.start=0 "$gr"
+expect "check breakage after the fill" 0 'breakage from: +t = 1 s \(breakage\.start\)$' -- "$dem2d" --check "$gr"
+
 # A short run with spectra on 1 and 3 ranks, and one resumed 1 -> 2 from a checkpoint at 0.3 s.
 run=(--quiet --set run.duration=0.3 --set output.collision_spectra=true --set output.snapshot_interval=0.1
   --set output.analysis_window=0.2)
@@ -78,7 +91,7 @@ same_spectra "spectra on 1 and 3 ranks" "$tmp/np1" "$tmp/np3"
 same_spectra "spectra resumed 1 -> 2" "$tmp/np1" "$tmp/rs"
 
 # run.json's mill object: the numbers of --check and a regime over the window.
-if out=$("$py" - "$tmp/np3/run.json" 2>&1 <<'EOF'
+if out=$("$py" - "$tmp/np3/run.json" "$src/post" 2>&1 <<'EOF'
 import json, math, sys
 m = json.load(open(sys.argv[1]))["mill"]
 assert abs(m["critical_speed_rad_s"] - math.sqrt(9.81 / 2.5)) < 1e-5, m
@@ -86,6 +99,17 @@ assert abs(m["bed_filling"] - 0.384 / 0.84) < 1e-5, m
 assert m["slice_thickness_m"] == 0.2, m
 assert abs(m["power_per_metre_W"] - m["power_avg_W"] / 0.2) < 1e-6 * m["power_avg_W"], m
 assert m["regime"] in ("slumping", "rolling", "cascading", "cascading-cataracting", "cataracting"), m
+# The --set options beside the deck's title (the title is the file's).
+j = json.load(open(sys.argv[1]))
+assert j["overrides"] == ["run.duration=0.3", "output.collision_spectra=true",
+                          "output.snapshot_interval=0.1", "output.analysis_window=0.2"], j["overrides"]
+sys.path.insert(0, sys.argv[2])
+import millplot
+title = millplot.run_title(j, "")
+assert title == j["deck"]["title"] + " [run.duration=0.3, output.collision_spectra=true, " \
+    "output.snapshot_interval=0.1, output.analysis_window=0.2]", title
+# No births: the particle-steps are the count times the steps.
+assert j["particle_steps"] == j["particles"] * j["steps"] == 240 * j["steps"], j
 print(m["regime"], round(m["power_avg_W"]), "W")
 EOF
 ); then pass "run.json mill: $out"; else fail "run.json mill: $out"; fi

@@ -83,7 +83,7 @@ check "report.py exits 0" "$py" "$post/report.py" "$run" -o "$report" --max-fram
 expected=(energies.png power.png charge_shape.png charge_000.400s.png charge_000.800s.png
           report.md index.html)
 if [ -f "$run/collisions.csv" ]; then expected+=(collisions.png); fi
-if command -v ffmpeg >/dev/null; then expected+=(charge.mp4); fi
+if command -v ffmpeg >/dev/null; then expected+=(charge.mp4); else expected+=(charge.gif); fi
 missing=""
 for f in "${expected[@]}"; do [ -s "$report/$f" ] || missing+=" $f"; done
 if [ -z "$missing" ]; then pass "report.py wrote ${expected[*]}"; else
@@ -135,6 +135,11 @@ if command -v ffmpeg >/dev/null && command -v ffprobe >/dev/null; then
   if [ "$frames" = 8 ]; then pass "charge.mp4 has --max-frames 8 frames"; else
     fail "charge.mp4 has '$frames' frames, expected 8"
   fi
+else  # without ffmpeg the animation is a GIF of the same frames
+  check "charge.gif has --max-frames 8 frames" "$py" -c "
+from PIL import Image
+im = Image.open('$report/charge.gif')
+assert im.n_frames == 8, im.n_frames"
 fi
 
 # The collision spectra on a made-up collisions.csv of the documented layout (two types, one

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/contact/materials.hpp"
@@ -55,9 +58,16 @@ double contact_time(double m_eff, double r_eff, double e_star, double v) {
   return 2.868 * std::pow(m_eff * m_eff / (r_eff * e_star * e_star * v), 0.2);
 }
 
-// Smallest restitution among the pairs of materials present (particles and walls). The thesis
-// law's damping ratio is converted through its hertz-mindlin equivalent (T22).
-double smallest_restitution(const Scene& scene, const ParticleStore& p, const PairTable& table) {
+// "a against b" or "a against the walls of b" (b: a wall material only).
+std::string pair_name(const Scene& scene, std::size_t a, std::size_t b, bool wall) {
+  return scene.materials[a].name + (wall ? " against a wall of " : " against ") +
+         scene.materials[b].name;
+}
+
+// Smallest restitution among the pairs of materials present (particles and walls), and the
+// pair. The thesis law's damping ratio is converted through its hertz-mindlin equivalent (T22).
+std::pair<double, std::string> smallest_restitution(const Scene& scene, const ParticleStore& p,
+                                                    const PairTable& table) {
   const std::size_t nm = scene.materials.size();
   std::vector<char> used(nm, 0);
   for (std::size_t k = 0; k < p.n_owned(); ++k) used[p.material[k]] = 1;
@@ -65,6 +75,7 @@ double smallest_restitution(const Scene& scene, const ParticleStore& p, const Pa
   std::vector<char> touched(nm, 0);
   for (const WallElement& e : walls.elements()) touched[e.material] = 1;
   double e_min = 1.0;
+  std::string which;
   for (std::size_t a = 0; a < nm; ++a) {
     if (!used[a]) continue;
     for (std::size_t b = 0; b < nm; ++b) {
@@ -73,10 +84,11 @@ double smallest_restitution(const Scene& scene, const ParticleStore& p, const Pa
       double e = c.restitution;
       if (scene.contact.model == ContactModelKind::kThesis)
         e = restitution_hertz_clamped(-c.zeta_n / std::sqrt(5.0 / 6.0));
+      if (e < e_min || which.empty()) which = pair_name(scene, a, b, !used[b]);
       e_min = std::min(e_min, e);
     }
   }
-  return e_min;
+  return {e_min, which};
 }
 
 }  // namespace
@@ -115,18 +127,22 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
     const double mass_a = Disc::mass(r_min[a], m.density);
     for (std::size_t b = 0; b < nm; ++b) {
       const double e_star = table(static_cast<int>(a), static_cast<int>(b)).e_star;
+      const auto shorter = [&](double t, bool wall) {
+        if (t < ts.hertz) ts.hertz_pair = pair_name(scene, a, b, wall);
+        ts.hertz = std::min(ts.hertz, t);
+      };
       // The smallest sphere against a wall of material b (m* = m, R* = r).
-      ts.hertz = std::min(ts.hertz, contact_time(mass_a, r_min[a], e_star, v.wall));
+      shorter(contact_time(mass_a, r_min[a], e_star, v.wall), true);
       // Against the smallest sphere of material b: the pair's reduced mass and radius.
       if (r_min[b] == std::numeric_limits<double>::max()) continue;
       const double mass_b = Disc::mass(r_min[b], scene.materials[b].density);
-      ts.hertz = std::min(
-          ts.hertz, contact_time(mass_a * mass_b / (mass_a + mass_b),
-                                 r_min[a] * r_min[b] / (r_min[a] + r_min[b]), e_star, v.pair));
+      shorter(contact_time(mass_a * mass_b / (mass_a + mass_b),
+                           r_min[a] * r_min[b] / (r_min[a] + r_min[b]), e_star, v.pair),
+              false);
     }
   }
   if (ts.rayleigh == std::numeric_limits<double>::max()) ts.rayleigh = ts.hertz = 1.0;
-  ts.restitution_min = smallest_restitution(scene, p, table);
+  std::tie(ts.restitution_min, ts.restitution_pair) = smallest_restitution(scene, p, table);
   ts.steps_per_contact = steps_per_contact_for(ts.restitution_min);
   const double bound = std::min(ts.rayleigh, ts.hertz);
   ts.safe_dt = std::min(scene.run.dt_safety * ts.rayleigh, ts.hertz / ts.steps_per_contact);

@@ -2,6 +2,8 @@
 // "The time step, stability and guards"; shown by --check).
 #pragma once
 
+#include <string>
+
 #include "core/base/scene.hpp"
 #include "core/shape/particles.hpp"
 
@@ -16,6 +18,9 @@ struct TimeScales {
   double steps_per_contact = 0.0;  // Hertz contact resolved with this many steps (see below)
   double safe_dt = 0.0;            // s, what dt = "auto" picks
   double limit_dt = 0.0;           // s, above this a dt is refused: 0.5 * min(rayleigh, hertz)
+  // What sets them, for --check: the pair of the shortest contact time and the pair of the
+  // smallest restitution, e.g. "ore against ore" or "ore against the walls of steel".
+  std::string hertz_pair, restitution_pair;
 };
 
 // Steps per Hertz contact that keep the restitution obtained within 1 % of the one asked
