@@ -53,13 +53,15 @@ int g_size = 1;
 // Collective. An output directory that cannot be written is bad input (exit 2), named by its
 // key; a write that fails later (disk full) stays an I/O failure (exit 4).
 // One folder, one run: the output directory is created, checked and locked for this run (a
-// folder in use, or holding another run's output without --overwrite, is bad input: exit 2).
+// folder in use, holding another run's output without --overwrite, or, for --restart, holding
+// the output of another run than the checkpoint's, is bad input: exit 2).
 OutputLock prepare_output(const Options& opt, const Scene& scene) {
   const std::string& dir = scene.output.directory;
   try {
     const Claim how = !opt.restart.empty() ? Claim::kContinue
                       : opt.overwrite      ? Claim::kOverwrite
                                            : Claim::kNew;
+    if (how == Claim::kContinue) check_restart_folder(MPI_COMM_WORLD, dir, opt.restart, scene);
     return claim_output_directory(MPI_COMM_WORLD, dir, how);
   } catch (const IoError& e) {
     const auto at = scene.where.find("output.directory");  // its line, or the --set

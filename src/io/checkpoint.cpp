@@ -1,25 +1,34 @@
 #include "io/checkpoint.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
 #include "core/base/errors.hpp"
+#include "io/checkpoint_checks.hpp"
 #include "io/deck.hpp"
 #include "io/hdf5.hpp"
 #include "io/output_dir.hpp"
+#include "io/series.hpp"
 #include "io/text.hpp"
 
 namespace dem2d {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The attribute that holds a dataset's checksum (rows_checksum, as an int64 of the same bits).
+constexpr const char* kChecksumAttribute = "checksum";
 
 // The scalars of a RunState as root attributes: the name and where the value lives.
 struct RealAttribute {
@@ -129,10 +138,23 @@ void write_state(h5::ParallelFile& file, const Simulation& sim, int ranks) {
   write_analysis(file, s);
 }
 
+// The checksum of this rank's items of `f` summed over the ranks (collective).
+std::uint64_t field_checksum(MPI_Comm comm, const FieldBase& f, std::size_t n) {
+  std::vector<std::byte> items(n * f.bytes_per_item());
+  for (std::size_t k = 0; k < n; ++k) f.pack(k, items.data() + k * f.bytes_per_item());
+  return mpi::sum(comm, rows_checksum(items.data(), n, f.bytes_per_item()));
+}
+
 void write_particles(h5::ParallelFile& file, const ParticleStore& p) {
   file.create_group("/particles");
   const h5::RowRange rows = h5::row_range(file.comm(), p.n_owned());
-  for (const FieldBase* f : p.fields()) file.write_field("/particles/" + f->name(), rows, *f);
+  file.write_attribute("/particles", "count", static_cast<std::int64_t>(rows.total));
+  for (const FieldBase* f : p.fields()) {
+    const std::string name = "/particles/" + f->name();
+    file.write_field(name, rows, *f);
+    const std::uint64_t sum = field_checksum(file.comm(), *f, p.n_owned());
+    file.write_attribute(name, kChecksumAttribute, static_cast<std::int64_t>(sum));
+  }
 }
 
 void write_histories(h5::ParallelFile& file, const HistoryRecords& h) {
@@ -146,6 +168,11 @@ void write_histories(h5::ParallelFile& file, const HistoryRecords& h) {
   }
   const h5::RowRange rows = h5::row_range(file.comm(), h.size());
   file.write_attribute("/contacts", "width", static_cast<std::int64_t>(h.width()));
+  std::vector<std::byte> records(h.size() * h.record_bytes());
+  for (std::size_t k = 0; k < h.size(); ++k) h.pack(k, records.data() + k * h.record_bytes());
+  const std::uint64_t sum =
+      mpi::sum(file.comm(), rows_checksum(records.data(), h.size(), h.record_bytes()));
+  file.write_attribute("/contacts", kChecksumAttribute, static_cast<std::int64_t>(sum));
   file.write_rows("/contacts/a", rows, a.data());
   file.write_rows("/contacts/b", rows, b.data());
   if (h.width() > 0) file.write_rows("/contacts/history", rows, values.data(), h.width());
@@ -167,6 +194,10 @@ class Reader {
     throw InputError(path_ + ": error: cannot restart from this checkpoint: " + why);
   }
   bool has(const char* name) const { return H5Lexists(file_.get(), name, H5P_DEFAULT) > 0; }
+  bool has_attribute(const char* object, const char* name) const {
+    return H5Aexists_by_name(file_.get(), object, name, H5P_DEFAULT) > 0;
+  }
+  const std::string& path() const { return path_; }
   // A scalar attribute of the object at `object` (the root by default).
   template <class T>
   T attribute(const char* name, hid_t type, const char* object = "/") const {
@@ -261,6 +292,12 @@ RunState read_state(const Reader& in, int my_rank, int my_size) {
   s.baseline_taken = in.attribute<std::int64_t>("baseline_taken", H5T_NATIVE_INT64) != 0;
   s.passes.last = static_cast<int>(in.attribute<std::int64_t>("passes_last", H5T_NATIVE_INT64));
   const auto ranks = static_cast<int>(in.attribute<std::int64_t>("ranks", H5T_NATIVE_INT64));
+  if (ranks < 1) in.fail(fmt::format("its attribute ranks = {} is below 1", ranks));
+  if (!std::isfinite(s.time) || s.time < 0.0 || s.step < 0)
+    in.fail(fmt::format("its attributes time = {} and step = {} are not a moment of a run", s.time,
+                        s.step));
+  if (!std::isfinite(s.dt) || s.dt <= 0.0)
+    in.fail(fmt::format("its attribute dt = {} is not above 0", s.dt));
   for (auto [name, value] : share_slots(s)) {
     const std::string path = std::string("/ranks/") + name;
     if (in.shape(path)[0] != static_cast<hsize_t>(ranks)) in.fail(path + " has the wrong length");
@@ -337,6 +374,43 @@ void check_deck(const Reader& in, const Scene& scene, const std::string& path) {
   throw InputError(message);
 }
 
+// A stored checksum (an old checkpoint has none: nothing to compare) against the values read.
+void check_sum(const Reader& in, const std::string& object, std::uint64_t computed) {
+  if (!in.has_attribute(object.c_str(), kChecksumAttribute)) return;
+  const auto stored = static_cast<std::uint64_t>(
+      in.attribute<std::int64_t>(kChecksumAttribute, H5T_NATIVE_INT64, object.c_str()));
+  if (stored != computed)
+    in.fail(
+        fmt::format("{}: its values do not match the checksum written with them ({:#018x}, "
+                    "read {:#018x}): the file was changed or damaged after it was written",
+                    object, stored, computed));
+}
+
+// The particles and contacts read: the count written, their values sound (checkpoint_checks.hpp),
+// then every dataset against its checksum.
+void check_resumption(const Reader& in, const Scene& scene, const Resumption& r) {
+  if (in.has_attribute("/particles", "count")) {
+    const auto count = in.attribute<std::int64_t>("count", H5T_NATIVE_INT64, "/particles");
+    if (count != static_cast<std::int64_t>(r.n_particles))
+      in.fail(
+          fmt::format("/particles: {} rows, its attribute count says {}", r.n_particles, count));
+  }
+  ParticleStore layout;
+  if (scene.breakage.present) layout.enable_damage();
+  if (scene.drum.present) layout.enable_last_contact();
+  if (const std::string problem = resumption_problem(scene, layout, r); !problem.empty())
+    in.fail(problem);
+  for (std::size_t f = 0; f < layout.fields().size(); ++f) {
+    const FieldBase& field = *layout.fields()[f];
+    check_sum(in, "/particles/" + field.name(),
+              rows_checksum(r.columns[f].data(), r.n_particles, field.bytes_per_item()));
+  }
+  const HistoryRecords& h = r.histories;
+  std::vector<std::byte> records(h.size() * h.record_bytes());
+  for (std::size_t k = 0; k < h.size(); ++k) h.pack(k, records.data() + k * h.record_bytes());
+  check_sum(in, "/contacts", rows_checksum(records.data(), h.size(), h.record_bytes()));
+}
+
 Resumption read_all(const std::string& path, const Scene& scene, int rank, int size) {
   const Reader in(path);
   Resumption r;
@@ -344,6 +418,7 @@ Resumption read_all(const std::string& path, const Scene& scene, int rank, int s
   check_deck(in, scene, path);
   read_particles(in, scene, r);
   read_histories(in, r);
+  check_resumption(in, scene, r);
   return r;
 }
 
@@ -379,7 +454,73 @@ bool may_change(const std::string& key) {
          key == "run.spatial_sort";
 }
 
+// The string value of the first "KEY": "..." in a JSON text (run.json), its escapes undone;
+// empty when there is none.
+std::string json_string(const std::string& text, const std::string& key) {
+  const std::string start = "\"" + key + "\": \"";
+  std::size_t at = text.find(start);
+  if (at == std::string::npos) return {};
+  std::string value;
+  for (at += start.size(); at < text.size() && text[at] != '"'; ++at) {
+    if (text[at] == '\\' && at + 1 < text.size()) ++at;
+    value += text[at];
+  }
+  return value;
+}
+
+// Which run wrote the output in `dir`, as its run.json tells.
+std::string folder_run(const fs::path& dir) {
+  std::ifstream in(dir / kRunJsonFile);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string title = json_string(text, "title"), deck = json_string(text, "deck_path");
+  if (deck.empty()) return "a run that left no run.json";
+  return fmt::format("the run '{}' of the deck {} (its run.json)", title, deck);
+}
+
+// Why the output in `dir` is not the run `scene` continues from `restart`, empty if it may be.
+std::string foreign_reason(const fs::path& dir, const std::string& restart, const Scene& scene) {
+  std::error_code ec;
+  std::ifstream series(dir / kSeriesFile);
+  std::string header;
+  const std::string mine =
+      fmt::format("{}", fmt::join(series_columns(scene.run.integrator == IntegratorKind::kIterative,
+                                                 is_ore_scene(scene), scene.drum.present),
+                                  ","));
+  if (series && std::getline(series, header) && header != mine)
+    return fmt::format("its {} has other columns than this run's", kSeriesFile);
+  const fs::path theirs = dir / kCheckpointFile;
+  if (!fs::exists(theirs, ec) || fs::equivalent(theirs, restart, ec)) return {};
+  try {
+    const Reader in(theirs.string());
+    const std::vector<std::string> deck = in.strings("/deck");
+    if (deck.size() != 1) return {};
+    const std::size_t n = physics_differences(deck[0], deck_without_particles(scene)).size();
+    if (n > 0)
+      return fmt::format("its {} holds a deck whose physics differs from this one's ({} {})",
+                         kCheckpointFile, n, n == 1 ? "key" : "keys");
+  } catch (const std::exception&) {  // not a checkpoint this reader can tell: no verdict
+  }
+  return {};
+}
+
 }  // namespace
+
+void check_restart_folder(MPI_Comm comm, const std::string& dir, const std::string& restart,
+                          const Scene& scene) {
+  std::string error;
+  const fs::path path = dir.empty() ? fs::path(".") : fs::path(dir);
+  if (mpi::rank(comm) == 0) {
+    const std::string reason = foreign_reason(path, restart, scene);
+    if (!reason.empty())
+      error = fmt::format(
+          "output directory '{}' holds the output of another run, {}: {}; --restart {} continues "
+          "the run of {}: give it that run's folder with --output {} or a new folder with "
+          "--output DIR (the run this folder holds continues from its own checkpoint)",
+          dir, folder_run(path), reason, restart, scene.deck_path,
+          fs::path(restart).parent_path().string());
+  }
+  mpi::agree_on_failure<IoError>(comm, error);
+}
 
 std::vector<std::string> physics_differences(const std::string& checkpoint_deck,
                                              const std::string& deck) {

@@ -9,19 +9,21 @@
 
 namespace dem2d {
 
-// The lock a run holds on its output directory; rank 0 removes the file when it goes.
+// The lock a run holds on its output directory: on rank 0, the lock file, open and locked
+// (flock) while the run lasts; the file is removed when the run ends.
 class OutputLock {
  public:
   OutputLock() = default;
-  explicit OutputLock(std::string path) : path_(std::move(path)) {}
-  OutputLock(OutputLock&& o) noexcept : path_(std::move(o.path_)) { o.path_.clear(); }
+  OutputLock(std::string path, int fd) : path_(std::move(path)), fd_(fd) {}
+  OutputLock(OutputLock&& o) noexcept : path_(std::move(o.path_)), fd_(o.fd_) { o.fd_ = -1; }
   OutputLock& operator=(OutputLock&&) = delete;
   OutputLock(const OutputLock&) = delete;
   OutputLock& operator=(const OutputLock&) = delete;
   ~OutputLock();
 
  private:
-  std::string path_;  // empty on ranks other than 0
+  std::string path_;
+  int fd_ = -1;  // -1 on ranks other than 0
 };
 
 // The files a run writes into its directory (their writers take the names from here), and the
@@ -41,16 +43,15 @@ inline constexpr const char* kOutputLockName = ".dem2d.lock";
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and
 // removed in it, and claims it for this run:
-//   - a folder locked by a dem2d run that is still running (same host, live pid) is refused,
-//     --overwrite or not;
-//   - a folder holding another run's output (a file of kRunOutputs, or the lock of a run that
-//     has ended without removing it) is refused unless `overwrite`, which removes those files;
-//   - then the lock is created (exclusively: of two runs starting together one is refused).
+//   - a folder whose lock file a running dem2d holds locked is refused, --overwrite or not (the
+//     message names the lock file and that run's pid); a lock file nobody holds is a dead run's
+//     and is taken over (a one-line notice on stderr), whatever pid it names;
+//   - a folder holding another run's output (a file of kRunOutputs, or the lock of a run on
+//     another host, which this host cannot check) is refused unless `overwrite`, which removes
+//     those files; with a checkpoint there, the message offers --restart first;
+//   - then the lock is taken (of two runs starting together one is refused).
 // The outcome is broadcast: on failure every rank throws IoError with the same text (the
-// reason and what to do: "give ... --output DIR", "--overwrite").
-// How a run takes its folder: a new run (refused if it holds another run's output), one that
-// replaces that output (--overwrite), or a restart that continues the output there (--restart:
-// a killed run's lock is taken over, the output kept).
+// reason and what to do: "give ... --output DIR", "--overwrite", "--restart").
 enum class Claim { kNew, kOverwrite, kContinue };
 OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, Claim how);
 

@@ -134,7 +134,7 @@ one_folder_one_run() {
   local sum_before np
   sum_before=$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")
   for np in 1 2; do
-    expect "np$np second run into one folder refused" 2 "^--output $tmp/drop: error: output directory '$tmp/drop' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf, checkpoint\.h5\); give this run a new folder with --output DIR, or --overwrite" -- \
+    expect "np$np second run into one folder refused" 2 "^--output $tmp/drop: error: output directory '$tmp/drop' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf, checkpoint\.h5\), which can be continued: resume it with --restart $tmp/drop/checkpoint\.h5, or give this run a new folder with --output DIR; --overwrite replaces that output and discards its checkpoint" -- \
       mpirun -np "$np" --oversubscribe "$dem2d" "$src/inputs/drop.in" --set run.duration=0.05 --output "$tmp/drop"
   done
   [ "$(md5sum "$tmp/drop/series.csv" "$tmp/drop/snapshots.h5" "$tmp/drop/run.json")" = "$sum_before" ] \

@@ -1230,13 +1230,12 @@ TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
   MPI_Barrier(MPI_COMM_WORLD);
   expect_same_io_error_everywhere(
       [&] { claim_output_directory(MPI_COMM_WORLD, out, Claim::kNew); },
-      "output directory '" + out + "' holds another run's output (" + kOutputLockName +
-          " of a run that did not end (pid 4194305 on host " + host() +
-          "), series.csv, "
-          "snapshots.h5); give this run a new folder with --output DIR, or --overwrite to "
-          "replace that output");
+      "output directory '" + out +
+          "' holds another run's output (series.csv, snapshots.h5); give this run a new folder "
+          "with --output DIR, or --overwrite to replace that output");
   MPI_Barrier(MPI_COMM_WORLD);
   EXPECT_TRUE(fs::exists(out + "/series.csv"));  // refused: nothing touched
+  EXPECT_TRUE(fs::exists(out + "/" + kOutputLockName));
   {
     const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, Claim::kOverwrite);
     MPI_Barrier(MPI_COMM_WORLD);
@@ -1245,6 +1244,59 @@ TEST(OutputDirectory, AnotherRunsOutputIsRefusedUnlessOverwritten) {
     EXPECT_TRUE(fs::exists(out + "/" + kOutputLockName));
     MPI_Barrier(MPI_COMM_WORLD);
   }
+}
+
+// A killed run's lock names a pid that a later, unrelated process may hold: the lock is the
+// dead run's all the same (nobody holds it locked) and every kind of claim takes it over.
+TEST(OutputDirectory, StaleLockNamingALiveProcessIsTakenOver) {
+  for (const Claim how : {Claim::kNew, Claim::kOverwrite, Claim::kContinue}) {
+    ScratchDir dir;
+    const std::string out = dir / "run";
+    const std::string lock = out + "/" + kOutputLockName;
+    if (comm_rank() == 0) {
+      fs::create_directories(out);
+      std::ofstream(lock) << host() << " " << ::getppid() << "\n";  // a live process
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    {
+      const OutputLock held = claim_output_directory(MPI_COMM_WORLD, out, how);
+      MPI_Barrier(MPI_COMM_WORLD);
+      if (comm_rank() == 0) {
+        std::ifstream in(lock);
+        std::string h;
+        long pid = 0;
+        in >> h >> pid;
+        EXPECT_EQ(pid, static_cast<long>(::getpid()));  // this run's lock now
+      }
+      MPI_Barrier(MPI_COMM_WORLD);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+    EXPECT_FALSE(fs::exists(lock));
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
+}
+
+// A folder with a checkpoint: a new run is offered --restart first, and told what --overwrite
+// discards.
+TEST(OutputDirectory, ACheckpointThereOffersRestartFirst) {
+  ScratchDir dir;
+  const std::string out = dir / "run";
+  if (comm_rank() == 0) {
+    fs::create_directories(out);
+    std::ofstream(out + "/series.csv") << "time\n";
+    std::ofstream(out + "/checkpoint.h5") << "x";
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_same_io_error_everywhere(
+      [&] { claim_output_directory(MPI_COMM_WORLD, out, Claim::kNew); },
+      "output directory '" + out +
+          "' holds another run's output (series.csv, checkpoint.h5), which can be continued: "
+          "resume it with --restart " +
+          out +
+          "/checkpoint.h5, or give this run a new folder with --output DIR; --overwrite "
+          "replaces that output and discards its checkpoint");
+  MPI_Barrier(MPI_COMM_WORLD);
+  EXPECT_TRUE(fs::exists(out + "/checkpoint.h5"));
 }
 
 TEST(OutputDirectory, UnwritableIsTheSameIoErrorOnEveryRank) {
