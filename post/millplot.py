@@ -329,13 +329,33 @@ def mean_power(series, fraction=0.5):
     return float(np.mean(series["drum_power"][mask]))
 
 
-def block_std(series, fraction=0.5, blocks=8):
-    """Standard deviation [W] of the mean drive power over `blocks` equal parts of the last
-    `fraction` of the run: how much the averaged power wanders (the raw 1 ms samples spike)."""
-    t, p = series["time"], series["drum_power"]
+def power_estimate(series, speed=None, fraction=0.5, min_turns=3, blocks=8):
+    """The drive's mean power over the last `fraction` of the run with its uncertainty, by batch
+    means: (mean [W], standard error [W], batches, what a batch is). The span is cut into whole
+    drum turns when it holds at least `min_turns` of them (the charge's motion repeats with the
+    drum, so turns are the natural batches), else into `blocks` equal parts; each batch's mean
+    is its change of the drum's work over its length (exact), the standard error the batch
+    means' standard deviation / sqrt(batches). Consecutive batches of a tumbling charge are
+    nearly independent once a batch spans a turn; shorter batches understate the error."""
+    t = np.asarray(series["time"], dtype=float)
     mask = tail_mask(t, fraction)
-    parts = [part for part in np.array_split(p[mask], blocks) if part.size]
-    return float(np.std([part.mean() for part in parts])) if len(parts) > 1 else 0.0
+    mean = mean_power(series, fraction)
+    work = series.get("drum_work", series.get("drive_work"))
+    if not mask.any() or work is None or work.dtype.kind != "f":
+        return mean, float("nan"), 0, "none"
+    t0, t1 = t[mask][0], t[-1]
+    turn = 2.0 * np.pi / abs(speed) if speed else 0.0
+    if turn > 0 and (t1 - t0) / turn >= min_turns:
+        n, kind = int((t1 - t0) / turn), "drum turns"
+        edges = t1 - turn * np.arange(n, -1, -1)
+    else:
+        n, kind = blocks, "equal parts"
+        edges = np.linspace(t0, t1, blocks + 1)
+    w = np.interp(edges, t, work)  # the work at the batch edges (rows fall on them or close)
+    means = np.diff(w) / np.diff(edges)
+    if n < 2:
+        return mean, float("nan"), n, kind
+    return mean, float(np.std(means, ddof=1) / np.sqrt(n)), n, kind
 
 
 def regime_column(series):

@@ -66,7 +66,9 @@ class Run:
         self.thickness, self.thickness_source = millplot.slice_thickness(self.info, self.h5_path)
         self.has_drum = millplot.has_drum(self.deck, self.series)
         has_power = self.has_drum and len(self.series["time"]) > 0
-        self.mean_power = millplot.mean_power(self.series) if has_power else None
+        self.mean_power, self.power_se, self.batches, self.batch_kind = (
+            millplot.power_estimate(self.series, millplot.drum_speed(self.deck)) if has_power
+            else (None, float("nan"), 0, "none"))
         self.per_metre = millplot.mill_scaling(self.thickness, self.mean_power)
 
     def caption(self):
@@ -140,7 +142,7 @@ def plot_power(run, path, window):
         sec.set_ylabel("per metre of mill length [kW/m]")
     if run.mean_power is not None:
         ax.axhline(run.mean_power / 1e3, color="black", linestyle=":", linewidth=1.0,
-                   label=f"mean over the last half: {run.mean_power / 1e3:.3g} kW")
+                   label=f"mean over the last half: {power_text(run)}")
     ax.set_xlabel("time [s]")
     ax.set_ylabel("drive power of the 2D slice [kW]")
     ax.set_title(f"{run.title}\ndrive power")
@@ -394,16 +396,22 @@ def regime_text(run):
     return f"{regime} (most frequent over the last half; at the end: {last})"
 
 
+def power_text(run):
+    """The one power figure to quote: the mean over the last half with its standard error by
+    batch means (millplot.power_estimate)."""
+    if run.mean_power is None:
+        return "unknown"
+    text = fmt(run.mean_power / 1e3, "kW")
+    if np.isfinite(run.power_se):
+        text += (f" ± {run.power_se / 1e3:.2g} kW (standard error of {run.batches} batch means "
+                 f"over {run.batch_kind})")
+    return text
+
+
 def mill_numbers(run):
     """[(quantity, value)] of a drum scene: regime, power and its scaling to a mill."""
-    s = run.series
     rows = [("regime", regime_text(run)),
-            ("mean drive power, last half of the run",
-             fmt(None if run.mean_power is None else run.mean_power / 1e3, "kW"))]
-    if "power_avg" in s and len(s["time"]) and s["power_avg"].dtype.kind == "f":
-        rows.append((f"power_avg at the end (mean over the last "
-                     f"{millplot.analysis_window(run.info):g} s)",
-                     fmt(float(s["power_avg"][-1]) / 1e3, "kW")))
+            ("mean drive power, last half of the run", power_text(run))]
     rows.append(("slice thickness (2D power is for this slice)",
                  f"{fmt(run.thickness, 'm')} ({run.thickness_source})" if run.thickness
                  else run.thickness_source))

@@ -12,10 +12,11 @@ For each fraction F of the classical critical speed sqrt(g/R) it runs
 available / R), each logging to DIR/f_F.log. From each run's series.csv it takes
   - the mean drive power over the last half of the run: the change of the drum's work over
     that span / its length;
-  - its spread: the standard deviation of the mean power over 8 equal parts of that half;
+  - its standard error by batch means: over whole drum turns when the half holds three or
+    more, else over 8 equal parts (millplot.power_estimate);
   - the regime: the most frequent value of the regime column over the last half ('-' when the
     run is shorter than twice the analysis window);
-and writes DIR/sweep.csv (fraction, speed_rad_s, speed_rpm, power_W, power_std_W, regime,
+and writes DIR/sweep.csv (fraction, speed_rad_s, speed_rpm, power_W, power_se_W, regime,
 power_per_metre_W) and DIR/power_vs_speed.png: the power [kW] against the fraction of
 critical speed, each point marked by its regime, a vertical line at 1 (critical), the speed in
 rpm on the top axis and the power per metre of mill length on the right (the 2D power is that of
@@ -44,7 +45,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import millplot  # noqa: E402
 
 DEFAULT_FRACTIONS = [round(0.2 + 0.1 * k, 2) for k in range(13)]  # 0.2 .. 1.4
-CSV_COLUMNS = ["fraction", "speed_rad_s", "speed_rpm", "power_W", "power_std_W", "regime",
+CSV_COLUMNS = ["fraction", "speed_rad_s", "speed_rpm", "power_W", "power_se_W", "regime",
                "power_per_metre_W"]
 
 
@@ -143,7 +144,7 @@ def summarise(folder, fraction, exit_status):
     if speed is None and wc:
         speed = fraction * wc
     row = {"fraction": fraction, "speed_rad_s": speed if speed is not None else math.nan,
-           "power_W": math.nan, "power_std_W": math.nan, "regime": "failed",
+           "power_W": math.nan, "power_se_W": math.nan, "regime": "failed",
            "power_per_metre_W": math.nan, "critical": wc, "title": str(deck.get("title") or "")}
     row["speed_rpm"] = row["speed_rad_s"] * millplot.RPM_PER_RAD_S
     series_path = os.path.join(folder, "series.csv")
@@ -152,8 +153,7 @@ def summarise(folder, fraction, exit_status):
     series = millplot.read_series(series_path)
     if not len(series["time"]):
         return row
-    row["power_W"] = millplot.mean_power(series)
-    row["power_std_W"] = millplot.block_std(series)
+    row["power_W"], row["power_se_W"], _, _ = millplot.power_estimate(series, speed)
     row["regime"] = millplot.dominant_regime(series)
     thickness, _ = millplot.slice_thickness(run, os.path.join(folder, "snapshots.h5"))
     per_metre = millplot.mill_scaling(thickness, row["power_W"])
@@ -170,17 +170,17 @@ def write_csv(path, rows):
         for r in rows:
             writer.writerow([f"{r['fraction']:g}", f"{r['speed_rad_s']:.6g}",
                              f"{r['speed_rpm']:.6g}", f"{r['power_W']:.6g}",
-                             f"{r['power_std_W']:.6g}", r["regime"],
+                             f"{r['power_se_W']:.6g}", r["regime"],
                              f"{r['power_per_metre_W']:.6g}"])
 
 
 def print_table(rows):
     """The sweep as a table on stdout."""
-    print(f"{'fraction':>8} {'rad/s':>8} {'rpm':>8} {'power kW':>10} {'std kW':>8} "
+    print(f"{'fraction':>8} {'rad/s':>8} {'rpm':>8} {'power kW':>10} {'+/- kW':>8} "
           f"{'kW/m':>8}  regime")
     for r in rows:
         print(f"{r['fraction']:8.3g} {r['speed_rad_s']:8.4g} {r['speed_rpm']:8.4g} "
-              f"{r['power_W'] / 1e3:10.4g} {r['power_std_W'] / 1e3:8.3g} "
+              f"{r['power_W'] / 1e3:10.4g} {r['power_se_W'] / 1e3:8.3g} "
               f"{r['power_per_metre_W'] / 1e3:8.4g}  {r['regime']}")
 
 
@@ -192,7 +192,7 @@ def plot(path, rows, title, duration):
         x = np.array([r["fraction"] for r in ok])
         p = np.array([r["power_W"] for r in ok]) / 1e3
         ax.plot(x, p, color="0.6", linewidth=1.2, zorder=1)
-        ax.errorbar(x, p, yerr=np.array([r["power_std_W"] for r in ok]) / 1e3, fmt="none",
+        ax.errorbar(x, p, yerr=np.array([r["power_se_W"] for r in ok]) / 1e3, fmt="none",
                     ecolor="0.4", capsize=3, zorder=2)
     seen = []
     for r in ok:

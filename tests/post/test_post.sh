@@ -76,6 +76,29 @@ sweep=$work/sweep
   >"$work/sweep.log" 2>&1 &
 sweep_pid=$!
 
+# --- power_estimate: batch means over whole drum turns ------------------------------------------
+# A made-up series: 10 s at 1 ms rows, the drum turning in 1 s (speed 2 pi rad/s), the power in
+# the last half constant within each turn at 10, 12, 11, 13, 9 kW: mean 11 kW, standard error
+# std(ddof=1) / sqrt(5) = 0.7071 kW; a speed that leaves fewer than 3 turns: 8 equal parts.
+check "power_estimate: batch means over drum turns" "$py" - "$post" <<'EOF'
+import sys
+import numpy as np
+sys.path.insert(0, sys.argv[1])
+import millplot
+t = np.round(np.arange(0, 10001) * 1e-3, 9)
+p = np.where(t < 5, 20e3, np.choose(np.clip(((t - 5 - 1e-9) // 1).astype(int), 0, 4),
+                                    [10e3, 12e3, 11e3, 13e3, 9e3]))
+work = np.concatenate([[0.0], np.cumsum(p[1:] * 1e-3)])  # the power of row k over (t_k-1, t_k]
+s = {"time": t, "drum_work": work, "drum_power": p}
+mean, se, n, kind = millplot.power_estimate(s, 2 * np.pi)
+assert (n, kind) == (5, "drum turns"), (n, kind)
+expect = np.std([10, 12, 11, 13, 9], ddof=1) / np.sqrt(5) * 1e3
+assert abs(mean - 11e3) < 1e-6 and abs(se - expect) < 1e-6, (mean, se, expect)
+mean, se, n, kind = millplot.power_estimate(s, 2 * np.pi / 2.0)
+assert (n, kind) == (8, "equal parts"), (n, kind)
+print(f"mean {mean / 1e3:.4g} kW +/- {se / 1e3:.4g} kW over {n} {kind}")
+EOF
+
 # --- report.py ----------------------------------------------------------------------------------
 report=$work/report
 check "report.py exits 0" "$py" "$post/report.py" "$run" -o "$report" --max-frames 8 \
@@ -118,6 +141,11 @@ assert f"{wc:.4g} rad/s" in md, f"critical speed {wc:.4g} rad/s not in report.md
 assert f"| fraction of critical speed | {deck['drum']['speed'] / wc:.3f} |" in md
 assert "| slice thickness (2D power is for this slice) | 0.2 m" in md
 assert "kW/m" in md and "charge_000.800s.png" in md and "energies.png" in md
+# One power figure with its standard error by batch means, and no second mean beside it.
+row = re.search(r"\| mean drive power, last half of the run \| [0-9.e+-]+ kW ± ([0-9.e+-]+) kW "
+                r"\(standard error of ([0-9]+) batch means over (drum turns|equal parts)\)", md)
+assert row and float(row.group(1)) > 0 and int(row.group(2)) >= 2, row
+assert "power_avg at the end" not in md
 print(f"regime {regime}, mean power {power / 1e3:.4g} kW")
 EOF
 # shown FILE...: index.html shows each picture.
