@@ -25,6 +25,8 @@ import sys
 import h5py
 import numpy as np
 
+from snapshot_order import snapshot_key, snapshot_names
+
 
 class Report:
     def __init__(self, show, allow_added=False):
@@ -142,18 +144,19 @@ def compare_materials(fa, fb, atol, report):
 def paired_snapshots(fa, fb, by_step, report):
     """The (name in the first, name in the second) snapshot pairs to compare."""
     def keyed(f):
-        names = sorted(f["snapshots"].keys()) if "snapshots" in f else []
+        names = snapshot_names(f)
         return {(int(f["snapshots"][n].attrs["step"]) if by_step else n): n for n in names}
     ka, kb = keyed(fa), keyed(fb)
-    only_a = sorted(set(ka) - set(kb))
-    only_b = sorted(set(kb) - set(ka))
+    order = (lambda k: k) if by_step else snapshot_key  # steps are numbers; names by index
+    only_a = sorted(set(ka) - set(kb), key=order)
+    only_b = sorted(set(kb) - set(ka), key=order)
     what = "steps" if by_step else "names"
     if only_a or (only_b and not (by_step and report.allow_added)):
         report.differ(f"/snapshots: {len(ka)} snapshots vs {len(kb)}; "
                       f"{what} only in the first: {only_a[:5]}, only in the second: {only_b[:5]}")
     elif only_b:
         report.added.add(f"snapshots at steps {only_b[:5]}")
-    return [(ka[k], kb[k]) for k in sorted(ka) if k in kb]
+    return [(ka[k], kb[k]) for k in sorted(ka, key=order) if k in kb]
 
 
 def main(argv=None):

@@ -25,6 +25,8 @@ import os
 import numpy as np
 from matplotlib.collections import EllipseCollection, LineCollection
 
+from snapshot_order import snapshot_names
+
 REGIMES = ["slumping", "rolling", "cascading", "cataracting", "centrifuging"]
 REGIME_COLORS = {
     "slumping": "tab:gray",
@@ -120,8 +122,8 @@ def read_collisions(path):
 # --- Snapshots -----------------------------------------------------------------------------------
 
 def list_snapshots(f):
-    """Names of the complete snapshots of an open snapshots.h5, in time order."""
-    return sorted(f["snapshots"].keys()) if "snapshots" in f else []
+    """Names of the complete snapshots of an open snapshots.h5, in time order (by index)."""
+    return snapshot_names(f)
 
 
 def read_snapshot(f, name):

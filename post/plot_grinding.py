@@ -24,6 +24,8 @@ import h5py  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from snapshot_order import snapshot_names  # noqa: E402
+
 
 def read_csv(path):
     """A CSV as a dict of column -> float array (empty arrays for a header-only file)."""
@@ -44,7 +46,7 @@ def ore_in_mill(h5_path, ore_index, count=4):
     """(time, radii, masses) of the ore in `count` snapshots spread over the run."""
     out = []
     with h5py.File(h5_path, "r") as f:
-        keys = sorted(f["snapshots"].keys())
+        keys = snapshot_names(f)
         for key in [keys[i] for i in np.linspace(0, len(keys) - 1, min(count, len(keys))).astype(int)]:
             g = f["snapshots"][key]
             ore = g["material"][:] == ore_index
@@ -56,7 +58,7 @@ def ore_in_mill(h5_path, ore_index, count=4):
 def ore_material(h5_path):
     """Index of the material that carries damage (the ore), else 0."""
     with h5py.File(h5_path, "r") as f:
-        keys = sorted(f["snapshots"].keys())
+        keys = snapshot_names(f)
         g = f["snapshots"][keys[-1]]
         if "damage" not in g:
             return 0

@@ -26,9 +26,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Circle, Patch  # noqa: E402
 
-
-def snapshot_names(f):
-    return sorted(f["snapshots"].keys()) if "snapshots" in f else []
+from snapshot_order import snapshot_names  # noqa: E402
 
 
 def material_names(f):

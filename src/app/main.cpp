@@ -18,6 +18,7 @@
 
 #include "core/base/errors.hpp"
 #include "core/run/simulation.hpp"
+#include "core/setup/validate.hpp"
 #include "io/check_report.hpp"
 #include "io/checkpoint.hpp"
 #include "io/console.hpp"
@@ -135,12 +136,18 @@ int report(const Options& opt, const Scene& scene, const Simulation& sim, const 
   return kExitUnstable;  // the run went to its end (run.guards = "warn"), but it is not sane
 }
 
+// Output intervals shorter than a step are written every step; the deck is told so.
+void tell_interval_notes(const Scene& scene, double dt) {
+  for (const std::string& note : output_interval_notes(scene, dt)) say(note + "\n", stderr);
+}
+
 int run(const Options& opt) {
   Scene scene = load_deck(opt.deck, opt.sets);
   if (!opt.output.empty()) scene.output.directory = opt.output;
   if (opt.check) {
     // Every rank evaluates the whole scene alike; rank 0 prints.
     const Simulation whole(scene);
+    tell_interval_notes(scene, whole.dt());
     say(check_report(whole, timed_trial(scene)));
     return kExitOk;
   }
@@ -148,6 +155,7 @@ int run(const Options& opt) {
   const bool resumed = !opt.restart.empty();
   const std::unique_ptr<Simulation> owned_sim = make_simulation(opt, scene, domain);
   Simulation& sim = *owned_sim;
+  tell_interval_notes(scene, sim.dt());
   const std::int64_t n_global = domain.sum(static_cast<std::int64_t>(sim.particles().n_owned()));
   const OutputSpec& out = scene.output;
   const OutputLock lock = prepare_output(opt, scene);

@@ -22,6 +22,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <numbers>
 #include <optional>
 #include <string_view>
 #include <utility>
@@ -92,6 +93,16 @@ class Accepted {
   }
   std::vector<std::pair<std::string_view, Value>> values_;
 };
+
+// A material's name holds no '.' (--set material.NAME.KEY names it), no ',' or '=' (the
+// snapshots list the materials as "0=steel,1=ore") and no control character (a line of a
+// message or of a CSV file).
+bool valid_material_name(std::string_view name) {
+  return !name.empty() && std::none_of(name.begin(), name.end(), [](char c) {
+    const auto u = static_cast<unsigned char>(c);
+    return c == '.' || c == ',' || c == '=' || u < 0x20 || u == 0x7F;
+  });
+}
 
 // A key that the keys around it make required (a fill's material, unless it reads a file).
 template <class T>
@@ -214,8 +225,10 @@ class DeckParser {
     const Accepted accepted = read_keys(r, deck::kMaterial, m);
     if (accepted.has("name")) {
       const auto same = std::find(material_names_.begin(), material_names_.end(), m.name);
-      if (m.name.empty() || m.name.find('.') != std::string::npos) {
-        r.invalid("name", "must be a non-empty name without '.'");
+      if (!valid_material_name(m.name)) {
+        r.invalid("name",
+                  "must be a non-empty name without '.', ',', '=' or control characters "
+                  "(letters, digits, spaces and other punctuation are allowed)");
         m.name.clear();
       } else if (same != material_names_.end()) {
         r.invalid("name",
@@ -334,6 +347,7 @@ class DeckParser {
 
   void read_drum(const toml::table& table) {
     const TableReader r(diag_, table, deck::kDrum);
+    const std::size_t errors_before = diag_.messages().size();
     DrumSpec& drum = scene_.drum;
     drum.present = true;
     const Accepted accepted = read_keys(r, deck::kDrum, drum);
@@ -350,6 +364,50 @@ class DeckParser {
     }
     const auto lifters = r.table_array("lifter");
     for (std::size_t i = 0; i < lifters.size(); ++i) read_lifter(*lifters[i], i, radius);
+    if (radius && diag_.messages().size() == errors_before) check_lifter_spacing(lifters);
+  }
+
+  // The bars of each [[drum.lifter]] stand apart from each other and from the other sets' bars.
+  void check_lifter_spacing(const std::vector<const toml::table*>& tables) {
+    const DrumGeometry drum(scene_.drum);
+    for (std::size_t l = 0; l < tables.size(); ++l) {
+      const LifterSpec& lifter = scene_.drum.lifters[l];
+      // The top face's corners inside the shell: half a width across, top from the centre.
+      const double top = drum.inner_radius() - lifter.height;
+      const double widest =
+          2.0 * std::sqrt(std::max(drum.radius() * drum.radius() - top * top, 0.0));
+      if (!(lifter.width < widest)) {
+        TableReader(diag_, *tables[l], deck::kLifter, l)
+            .invalid("width", fmt::format("must be < {:.3g} m: wider, the corners of a bar's top "
+                                          "face ({:g} m from the centre) lie outside the shell "
+                                          "(drum.radius = {:g})",
+                                          widest, top, drum.radius()));
+        return;
+      }
+      const int fit = drum.bars_that_fit(l);
+      if (lifter.count <= fit) continue;
+      TableReader(diag_, *tables[l], deck::kLifter, l)
+          .invalid(
+              "count",
+              fmt::format("the {} bars of width {:g} m overlap their neighbours: {} x {:g} m "
+                          "= {:.3g} m of bars around the circle of their top faces, {:.3g} m "
+                          "long (radius {:.3g} m); at most {} bars of this width fit "
+                          "there apart (or, for {} bars, a width below {:.3g} m)",
+                          lifter.count, lifter.width, lifter.count, lifter.width,
+                          lifter.count * lifter.width, 2.0 * std::numbers::pi * top, top, fit,
+                          lifter.count, 2.0 * top * std::tan(std::numbers::pi / lifter.count)));
+      return;
+    }
+    if (const auto pair = drum.overlapping_sets()) {
+      const DrumGeometry::Bar& a = drum.bars()[pair->first];
+      const DrumGeometry::Bar& b = drum.bars()[pair->second];
+      const TableReader r(diag_, *tables[b.lifter], deck::kLifter, b.lifter);
+      const std::string message = fmt::format(
+          "bar {} of drum.lifter[{}] overlaps bar {} of drum.lifter[{}]; give the "
+          "sets angles that keep their bars apart",
+          b.index, b.lifter, a.index, a.lifter);
+      r.has("angle") ? r.invalid("angle", message) : r.error(r.path() + ": " + message);
+    }
   }
 
   // At most one of speed, speed_rpm and critical_fraction. The per-key pass stored the first
@@ -628,8 +686,10 @@ void record_where(const toml::table& root, const Diagnostics& diag, Scene& scene
   const auto put = [&](const std::string& key, const toml::node* node) {
     if (node != nullptr) scene.where[key] = diag.where(*node);
   };
-  for (const char* key : {"run.duration", "run.dt", "drum.speed", "drum.speed_rpm",
-                          "drum.critical_fraction", "feed.velocity", "output.directory"}) {
+  for (const char* key :
+       {"run.duration", "run.dt", "drum.speed", "drum.speed_rpm", "drum.critical_fraction",
+        "feed.velocity", "output.directory", "output.series_interval", "output.snapshot_interval",
+        "output.checkpoint_interval"}) {
     put(key, root.at_path(key).node());
   }
   const auto each = [&](std::string_view name, std::initializer_list<std::string_view> keys) {

@@ -146,6 +146,11 @@ inline constexpr Bound kAtLeastOne{1.0, Bound{}.hi, false, false};  // >= 1 (int
 inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (integers)
 inline constexpr Bound kSizeRatio{1.1, 1e3, false, false};          // [1.1, 1000]
 inline constexpr Bound kSizeEdge{1e-9, 10.0, false, true};          // [1 nm, 10 m)
+// A particle's radius, at least 1 nm: far below any particle a mill holds, and far above where
+// its mass rho 4/3 pi r^3 and moment of inertia 2/5 m r^2 leave the normal doubles (for steel
+// the inertia below about 5e-63 m, the mass below 1e-104 m: radius = 1e-120 has mass 0).
+inline constexpr double kMinRadius = 1e-9;
+inline constexpr Bound kRadius{kMinRadius, Bound{}.hi, false, false};  // >= 1 nm
 
 // A key's value once checked: a number, integer, bool, string (also a choice's word, or
 // "auto"), [x, y], or a list of names.
@@ -419,7 +424,7 @@ inline constexpr Key<MaterialSpec> kMaterialKeys[] = {
      .type = Type::kString,
      .need = Need::kRequired,
      .field = member<&MaterialSpec::name>(),
-     .allowed = "unique, non-empty, no `.`",
+     .allowed = "unique, non-empty, no `.`, `,`, `=` or control characters",
      .doc = "how the rest of the deck (and `--set material.NAME.KEY`) refers to it"},
     {.name = "density",
      .need = Need::kRequired,
@@ -644,7 +649,7 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .doc = "read the particles from a packing made elsewhere (below)"},
     {.name = "radius",
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = {
          [](FillSpec& f, const Value& v) { f.radius_min = f.radius_max = std::get<double>(v); },
          [](const FillSpec& f) -> std::optional<Value> { return f.radius_min; }},
@@ -653,19 +658,19 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .doc = "every particle has this radius"},
     {.name = "radius_min",
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&FillSpec::radius_min>(),
      .written_if = polydisperse,
      .default_text = "–",
-     .allowed = "> 0, ≤ `radius_max`",
+     .allowed = "≥ 1e-09, ≤ `radius_max`",
      .doc = "instead of `radius`: radii are drawn uniformly in [`radius_min`, `radius_max`]"},
     {.name = "radius_max",
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&FillSpec::radius_max>(),
      .written_if = polydisperse,
      .default_text = "–",
-     .allowed = "> 0, ≥ `radius_min`",
+     .allowed = "≥ 1e-09, ≥ `radius_min`",
      .doc = "instead of `radius`: the largest radius (with `radius_min`)"},
     {.name = "region",
      .type = Type::kChoice,
@@ -704,7 +709,7 @@ inline constexpr Key<ParticleSpec> kParticleKeys[] = {
     {.name = "radius",
      .need = Need::kRequired,
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&ParticleSpec::radius>()},
     {.name = "position",
      .type = Type::kVector,
@@ -790,7 +795,7 @@ inline constexpr Key<BreakageSpec> kBreakageKeys[] = {
     {.name = "minimum_radius",
      .need = Need::kRequired,
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&BreakageSpec::minimum_radius>(),
      .doc = "smaller particles do not break; the smallest fragment, minimum_radius / "
             "fragments_max^(1/3), sets `dt = \"auto\"` from the start"},
@@ -823,15 +828,15 @@ inline constexpr Key<FeedSpec> kFeedKeys[] = {
     {.name = "radius_min",
      .need = Need::kRequired,
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&FeedSpec::radius_min>(),
      .doc = "radii are uniform in [radius_min, radius_max]"},
     {.name = "radius_max",
      .need = Need::kRequired,
      .unit = "m",
-     .range = kPositive,
+     .range = kRadius,
      .field = member<&FeedSpec::radius_max>(),
-     .allowed = "≥ radius_min"},
+     .allowed = "≥ 1e-09, ≥ radius_min"},
     {.name = "start",
      .unit = "s",
      .range = kNonNegative,
@@ -893,18 +898,20 @@ inline constexpr Key<OutputSpec> kOutputKeys[] = {
      .unit = "s",
      .range = kPositive,
      .field = member<&OutputSpec::series_interval>(),
-     .doc = "simulated time between rows of `series.csv`"},
+     .doc = "simulated time between rows of `series.csv`; shorter than dt: every step"},
     {.name = "snapshot_interval",
      .unit = "s",
      .range = kNonNegative,
      .field = member<&OutputSpec::snapshot_interval>(),
-     .doc = "simulated time between snapshots; 0: the final state only"},
+     .doc =
+         "simulated time between snapshots (shorter than dt: every step); 0: the final state only"},
     {.name = "checkpoint_interval",
      .unit = "s",
      .range = kNonNegative,
      .field = member<&OutputSpec::checkpoint_interval>(),
-     .doc = "simulated time between checkpoints (`checkpoint.h5`, replaced each time); 0: none "
-            "on the way. A checkpoint is always written at the end and when the run is "
+     .doc = "simulated time between checkpoints (`checkpoint.h5`, replaced each time; shorter than "
+            "dt: every step); 0: none on the way. A checkpoint is always written at the end and "
+            "when the run is "
             "interrupted"},
     {.name = "checkpoint_minutes",
      .unit = "min",

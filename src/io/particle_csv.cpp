@@ -57,22 +57,61 @@ class CsvErrors {
   int count_ = 0;
 };
 
-std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  for (std::size_t start = 0;;) {
-    const std::size_t comma = line.find(',', start);
-    std::string_view field = trim(line.substr(start, comma - start));
-    if (field.size() >= 2 && field.front() == '"' && field.back() == '"') {
-      field = field.substr(1, field.size() - 2);
+// One line split into its fields (RFC 4180): a field in double quotes may hold commas, and a
+// doubled quote inside it stands for one quote; spaces around a field are dropped. A quoted
+// field ends on its line (no value a packing holds spans lines).
+struct Fields {
+  std::vector<std::string> fields;
+  std::string error;  // what is wrong with the line; "" when nothing
+};
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+// The quoted field that starts at line[i] (a quote) into `field`; i is left after it. Returns
+// false when the line ends inside it.
+bool read_quoted(std::string_view line, std::size_t& i, std::string& field) {
+  for (++i; i < line.size(); ++i) {
+    if (line[i] != '"') {
+      field += line[i];
+    } else if (i + 1 < line.size() && line[i + 1] == '"') {
+      field += '"';
+      ++i;
+    } else {
+      ++i;
+      return true;
     }
-    fields.push_back(field);
-    if (comma == std::string_view::npos) return fields;
-    start = comma + 1;
+  }
+  return false;
+}
+
+Fields split_fields(std::string_view line) {
+  Fields out;
+  for (std::size_t i = 0;; ++i) {  // ++i: past the comma
+    while (i < line.size() && is_blank(line[i])) ++i;
+    std::string field;
+    if (i < line.size() && line[i] == '"') {
+      const std::size_t number = out.fields.size() + 1;
+      if (!read_quoted(line, i, field)) {
+        out.error = fmt::format("field {} opens a quote that the line does not close", number);
+        return out;
+      }
+      while (i < line.size() && is_blank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') {
+        out.error = fmt::format("field {} has text after its closing quote", number);
+        return out;
+      }
+    } else {
+      const std::size_t comma = std::min(line.find(',', i), line.size());
+      field = std::string(trim(line.substr(i, comma - i)));
+      i = comma;
+    }
+    out.fields.push_back(std::move(field));
+    if (i >= line.size()) return out;
   }
 }
 
 // The header row: which field holds each column. Reports unknown, repeated and missing ones.
-ColumnIndex read_header(const std::vector<std::string_view>& fields, int line, CsvErrors& errors) {
+ColumnIndex read_header(const std::vector<std::string>& fields, int line, CsvErrors& errors) {
   ColumnIndex index;
   index.fill(-1);
   std::vector<std::string_view> suggested;  // a misspelt column is not also "missing"
@@ -105,7 +144,7 @@ ColumnIndex read_header(const std::vector<std::string_view>& fields, int line, C
 }
 
 // One data row as a particle, or nullopt after reporting what is wrong with it.
-std::optional<ParticleSpec> read_row(const std::vector<std::string_view>& fields,
+std::optional<ParticleSpec> read_row(const std::vector<std::string>& fields,
                                      const ColumnIndex& index, int line,
                                      const std::vector<std::string>& material_names,
                                      const CsvDefaults& defaults, CsvErrors& errors) {
@@ -130,12 +169,14 @@ std::optional<ParticleSpec> read_row(const std::vector<std::string_view>& fields
   p.radius = number(kRadius, 0.0);
   p.velocity = {number(kVx, defaults.velocity.x), number(kVy, defaults.velocity.y)};
   p.spin = number(kSpin, 0.0);
-  if (ok && p.radius <= 0.0) {
-    errors.at(line, fmt::format("column 'radius' = {}: must be > 0", p.radius));
+  if (ok && !deck::kRadius.contains(p.radius)) {
+    errors.at(line,
+              fmt::format("column 'radius' = {}: must be {}", p.radius, deck::kRadius.text()));
     ok = false;
   }
   const std::string_view material =
-      index[kMaterial] >= 0 ? fields[static_cast<std::size_t>(index[kMaterial])] : "";
+      index[kMaterial] >= 0 ? std::string_view(fields[static_cast<std::size_t>(index[kMaterial])])
+                            : std::string_view();
   p.material = material.empty() ? defaults.material : std::string(material);
   if (p.material.empty()) {
     errors.at(line, "no material: the material field is empty and the [[fill]] gives none");
@@ -169,7 +210,17 @@ CsvPacking read_particle_csv(std::string_view text, const std::string& shown,
     const std::string_view row = trim(text.substr(0, newline));
     text.remove_prefix(newline == std::string_view::npos ? text.size() : newline + 1);
     if (row.empty() || row.front() == '#') continue;
-    const std::vector<std::string_view> fields = split_fields(row);
+    const Fields split = split_fields(row);
+    const std::vector<std::string>& fields = split.fields;
+    if (!split.error.empty() && !index) {
+      errors.header(line, split.error);
+      index.emplace().fill(-1);
+      break;  // no columns: the rows cannot be read
+    }
+    if (!split.error.empty()) {
+      errors.at(line, split.error);
+      continue;
+    }
     if (!index) {
       index = read_header(fields, line, errors);
       n_fields = fields.size();

@@ -2,8 +2,9 @@
 //
 // Format: a header row naming the columns, in any order and any case: x, y, radius (m,
 // required), vx, vy (m/s), spin (rad/s), material (a [[material]] name) optional; then one
-// particle per row. Fields are separated by commas; a field may be wrapped in double quotes;
-// blank lines and lines starting with '#' are skipped.
+// particle per row. Fields are separated by commas and may be quoted as RFC 4180 says: a field
+// in double quotes may hold commas, a doubled quote inside it is one quote; a quoted field ends
+// on its line. Blank lines and lines starting with '#' are skipped.
 #pragma once
 
 #include <string>

@@ -320,6 +320,24 @@ particle_escapes() {
   done
 }
 
+# intervals_below_dt: output intervals shorter than a step are written every step, and the run
+# says so for each key the deck (here --set) gave, at its location.
+intervals_below_dt() {
+  local out code=0 key rows
+  out=$("$dem2d" "$src/inputs/drop.in" --quiet --set run.dt=1e-5 --set run.duration=1e-4 \
+    --set output.snapshot_interval=1e-6 --set output.series_interval=2e-6 \
+    --output "$tmp/every_step" 2>&1) || code=$?
+  [ "$code" = 0 ] && pass "intervals below dt: exit 0" || fail "intervals below dt: exit $code"
+  for key in snapshot_interval=1e-6 series_interval=2e-6; do
+    grep -qE "^--set output\.$key: note: output\.${key%%=*} = [0-9e.-]+ s is shorter than one step, dt = 1e-05 s \(run\.dt\): written every step" <<<"$out" &&
+      pass "intervals below dt: a note at --set output.$key" ||
+      { fail "intervals below dt: no note for output.$key"; first_lines 5 <<<"$out"; }
+  done
+  rows=$(($(wc -l <"$tmp/every_step/series.csv") - 1))
+  [ "$rows" = 11 ] && pass "intervals below dt: series.csv has a row every step (11)" ||
+    fail "intervals below dt: series.csv has $rows rows, expected 11 (steps 0 to 10)"
+}
+
 make_bad_decks
 job_init "$tmp/jobs"
 # Grinding first: it is the longest job by far (its 2- and 3-rank runs most of all) and the
@@ -339,6 +357,7 @@ job "guards warn, 1 rank" guards_warn 1
 job "guards warn, 2 ranks" guards_warn 2
 job "motion guard" motion_guard_stops
 job "particle leaving the drum" particle_escapes
+job "output intervals below dt" intervals_below_dt
 job_results
 
 echo "cli: $failures failure(s)"

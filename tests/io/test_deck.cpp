@@ -22,6 +22,7 @@
 #include "core/base/errors.hpp"
 #include "io/deck.hpp"
 #include "io/deck_schema.hpp"
+#include "io/particle_csv.hpp"
 #include "io/run_json.hpp"
 #include "io/text.hpp"
 
@@ -619,8 +620,8 @@ position = [0.0, 0.5]
 )");
   EXPECT_TRUE(
       has_message(messages, "deck.in:2:1: error: material[0].density is required (a number > 0)"));
-  EXPECT_TRUE(
-      has_message(messages, "deck.in:6:1: error: particle[0].radius is required (a number > 0)"));
+  EXPECT_TRUE(has_message(
+      messages, "deck.in:6:1: error: particle[0].radius is required (a number >= 1e-09)"));
   EXPECT_EQ(messages.size(), 2u);
 }
 
@@ -745,6 +746,92 @@ width = 0.1
                           "deck.in:22:10: error: drum.lifter[0].height = 3.0: must be "
                           "< drum.radius = 2.5"));
   EXPECT_EQ(messages.size(), 5u);
+}
+
+// Lifter bars stand apart: within a set (the thesis's 12 bars of 0.1 m pass, a set wider than
+// its spacing does not), across sets (two sets at the same angle), and each narrower than the
+// drum's diameter. A set that fits exactly, bars touching at their top corners, passes.
+TEST(DeckErrors, LifterBarsStandApart) {
+  const std::string drum = kMinimalDeck + R"(
+[drum]
+radius = 1.0
+material = "steel"
+)";
+  const auto lifters = [&](const std::string& sets) { return drum + sets; };
+  EXPECT_NO_THROW(parse_deck_string(lifters(R"(
+[[drum.lifter]]
+count = 12
+height = 0.1
+width = 0.1
+[[drum.lifter]]
+count = 12
+height = 0.05
+width = 0.1
+angle = 15.0
+)"),
+                                    "deck.in"));
+  // A bar spans 2 atan(0.25 / 0.7) = 0.686 rad at its top corners: 2 pi / 0.686 = 9.16, so 9
+  // bars fit and 10 do not.
+  EXPECT_NO_THROW(parse_deck_string(
+      lifters("[[drum.lifter]]\ncount = 9\nheight = 0.3\nwidth = 0.5\n"), "deck.in"));
+  auto messages = deck_errors(lifters("[[drum.lifter]]\ncount = 10\nheight = 0.3\nwidth = 0.5\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "deck.in:16:9: error: drum.lifter[0].count = 10: the 10 bars of width 0.5 m overlap "
+            "their neighbours: 10 x 0.5 m = 5 m of bars around the circle of their top faces, "
+            "4.4 m long (radius 0.7 m); at most 9 bars of this width fit there apart (or, for 10 "
+            "bars, a width below 0.455 m)");
+  messages = deck_errors(lifters(R"(
+[[drum.lifter]]
+count = 8
+height = 0.1
+width = 0.1
+[[drum.lifter]]
+count = 4
+height = 0.2
+width = 0.05
+angle = 90.0
+)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:24:9: error: drum.lifter[1].angle = 90.0: bar 0 of "
+                          "drum.lifter[1] overlaps bar 2 of drum.lifter[0]; give the sets angles "
+                          "that keep their bars apart"));
+  EXPECT_EQ(messages.size(), 1u);
+  // The top face 0.9 m from the centre: its corners stay inside the shell up to a width of
+  // 2 sqrt(1 - 0.81) = 0.872 m.
+  messages = deck_errors(lifters("[[drum.lifter]]\ncount = 1\nheight = 0.1\nwidth = 0.9\n"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:18:9: error: drum.lifter[0].width = 0.9: must be < 0.872 m: "
+                          "wider, the corners of a bar's top face (0.9 m from the centre) lie "
+                          "outside the shell (drum.radius = 1)"));
+  EXPECT_EQ(messages.size(), 1u);
+}
+
+// A material's name holds no '.', ',', '=' or control character; anything else is a name.
+TEST(DeckErrors, MaterialNamesTheSnapshotsCanList) {
+  for (const std::string name : {"iron ore", "rubber-liner", "Stahl (hart)", "ore_2"}) {
+    const std::string deck = R"(
+[[material]]
+name = ")" + name + R"("
+density = 7800.0
+youngs_modulus = 2.0e11
+[[particle]]
+material = ")" + name + R"("
+radius = 0.1
+position = [0.0, 0.5]
+)";
+    EXPECT_NO_THROW(parse_deck_string(deck, "deck.in")) << name;
+  }
+  for (const std::string name : {"a,b", "a=b", "a.b", "a\\tb", "a\\nb", ""}) {
+    const auto messages =
+        deck_errors("[[material]]\nname = \"" + name + "\"\ndensity = 1.0\nyoungs_modulus = 1.0\n");
+    ASSERT_FALSE(messages.empty()) << name;
+    EXPECT_TRUE(messages[0].starts_with("deck.in:2:8: error: material[0].name = ") &&
+                messages[0].ends_with(
+                    ": must be a non-empty name without '.', ',', '=' or control characters "
+                    "(letters, digits, spaces and other punctuation are allowed)"))
+        << messages[0];
+  }
 }
 
 TEST(DeckErrors, FillKeys) {
@@ -874,7 +961,7 @@ position = [0.0]
                           "[[material]]; did you mean 'sliding_friction'?"));
   EXPECT_TRUE(has_message(messages,
                           "deck.in:14:10: error: particle[0].radius = -0.1: must be "
-                          "> 0"));
+                          ">= 1e-09"));
   EXPECT_TRUE(has_message(messages,
                           "deck.in:15:12: error: particle[0].position = [0.0]: "
                           "expected an array of two numbers [x, y]"));
@@ -1023,7 +1110,7 @@ material = "steel"
                                   "a number"));
   EXPECT_TRUE(has_message(messages, bad +
                                         ":4: error: fill[0].file row: column 'radius' = -0.1: must "
-                                        "be > 0"));
+                                        "be >= 1e-09"));
   EXPECT_TRUE(has_message(
       messages, bad + ":5: error: fill[0].file row: column 'material' = \"stel\": no such "
                       "material; did you mean \"steel\"? (defined: "
@@ -1045,6 +1132,44 @@ material = "steel"
                                         (dir.path() / "missing.csv").string() +
                                         ": No such file or directory"));
   EXPECT_EQ(messages.size(), 7u);
+}
+
+// RFC 4180 quoting: a field in double quotes may hold commas, and a doubled quote inside it is
+// one quote; spaces around a quoted field are dropped. A quote left open is an error at its line.
+TEST(DeckCsv, QuotedFieldsFollowRfc4180) {
+  const std::vector<std::string> materials = {"steel, hardened", "say \"hi\"", "ore"};
+  const CsvPacking good = read_particle_csv(
+      "\"x\",\"y\",\"radius\",material\n"
+      "0.0,0.0,0.1,\"steel, hardened\"\n"
+      "\"1.5\", \"-2\" ,0.2,\"say \"\"hi\"\"\"\n"
+      "2.0,0.0,0.1,ore\n"
+      "3.0,0.0,0.1,\"\"\n",
+      "q.csv", materials, CsvDefaults{"ore", {}}, "fill[0].file");
+  EXPECT_TRUE(good.errors.empty()) << fmt::format("{}", fmt::join(good.errors, "\n"));
+  ASSERT_EQ(good.particles.size(), 4u);
+  EXPECT_EQ(good.particles[0].material, "steel, hardened");
+  EXPECT_EQ(good.particles[1].position, (Vec2{1.5, -2.0}));
+  EXPECT_EQ(good.particles[1].radius, 0.2);
+  EXPECT_EQ(good.particles[1].material, "say \"hi\"");
+  EXPECT_EQ(good.particles[2].material, "ore");
+  EXPECT_EQ(good.particles[3].material, "ore");  // "" quoted is an empty field: the default
+  EXPECT_EQ(good.particles[3].source_line, 5);
+
+  const CsvPacking bad = read_particle_csv(
+      "x,y,radius,material\n"
+      "0.0,0.0,0.1,\"steel, hardened\n"
+      "0.0,0.0,0.1,\"ore\"x\n"
+      "0.0,0.0,0.1,\"iron, ore\"\n",
+      "q.csv", materials, CsvDefaults{}, "fill[0].file");
+  ASSERT_EQ(bad.errors.size(), 3u) << fmt::format("{}", fmt::join(bad.errors, "\n"));
+  EXPECT_EQ(bad.errors[0],
+            "q.csv:2: error: fill[0].file row: field 4 opens a quote that the line does not "
+            "close");
+  EXPECT_EQ(bad.errors[1],
+            "q.csv:3: error: fill[0].file row: field 4 has text after its closing quote");
+  EXPECT_TRUE(bad.errors[2].starts_with(
+      "q.csv:4: error: fill[0].file row: column 'material' = \"iron, ore\": no such material"))
+      << bad.errors[2];
 }
 
 TEST(DeckCsv, FileFillRejectsPlacementKeys) {

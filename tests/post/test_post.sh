@@ -56,6 +56,43 @@ for path in sys.argv[1:]:
 EOF
 }
 
+# --- Snapshot order: by index, not by name ------------------------------------------------------
+# /snapshots names a snapshot by its index in at least six digits, so past 999 999 the names sort
+# wrongly as text ("1000000" < "999999"). On a made-up snapshots.h5 whose names cross a million,
+# every script that lists snapshots takes them in index (= time) order.
+check "snapshots past 999999 in index order (millplot, render_snapshot, plot_grinding, h5compare)" \
+  "$py" - "$post" "$work/order.h5" <<'EOF'
+import subprocess, sys
+import h5py
+import numpy as np
+post, path = sys.argv[1], sys.argv[2]
+sys.path.insert(0, post)
+names = ["000007", "999998", "999999", "1000000", "1000001"]  # in index and time order
+with h5py.File(path, "w") as f:
+    f["materials/name"] = [b"steel"]
+    for k, name in enumerate(names):
+        g = f.create_group(f"snapshots/{name}")
+        g.attrs["time"], g.attrs["step"] = float(k), np.int64(10 * k)
+        n = k + 1
+        g["id"] = np.arange(n, dtype=np.int64)
+        g["position"], g["velocity"] = np.zeros((n, 2)), np.zeros((n, 2))
+        g["radius"], g["damage"] = np.full(n, 0.1), np.zeros(n)
+        g["material"] = np.zeros(n, dtype=np.int32)
+import h5compare, millplot, plot_grinding, render_snapshot  # noqa: E402
+with h5py.File(path, "r") as f:
+    assert millplot.list_snapshots(f) == names, millplot.list_snapshots(f)
+    assert render_snapshot.snapshot_names(f) == names, render_snapshot.snapshot_names(f)
+    pairs = h5compare.paired_snapshots(f, f, False, h5compare.Report(0))
+    assert [a for a, _ in pairs] == names, pairs
+times = [t for t, _, _ in plot_grinding.ore_in_mill(path, 0, count=len(names))]
+assert times == [float(k) for k in range(len(names))], times
+out = subprocess.run([sys.executable, f"{post}/render_snapshot.py", path, "--list"],
+                     capture_output=True, text=True, check=True).stdout
+listed = [line.split()[1] for line in out.splitlines() if line.strip()]
+assert listed == names, listed
+print("order:", " ".join(listed))
+EOF
+
 # --- A short run: 0.8 s of the waterfall deck, snapshots every 0.1 s, spectra on ------------------
 run=$work/run
 start=$SECONDS

@@ -1,6 +1,7 @@
 #include "core/geometry/drum_geometry.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <numbers>
 
@@ -21,6 +22,7 @@ DrumGeometry::DrumGeometry(const DrumSpec& drum) : drum_(drum) {
     tallest_ = std::max(tallest_, lifter.height);
     // The feet on the circle of the drum's radius, half a width to each side of the radial.
     const double foot = std::sqrt(drum.radius * drum.radius - 0.25 * lifter.width * lifter.width);
+    first_bar_.push_back(bars_.size());
     for (int k = 0; k < lifter.count; ++k) {
       Bar b;
       b.lifter = l;
@@ -68,6 +70,69 @@ std::optional<LifterOverlap> DrumGeometry::bar_overlap(Vec2 x, double r) const {
     const bool inside = dx == 0.0 && dy == 0.0;
     if (inside || dx * dx + dy * dy < r * r)
       return LifterOverlap{b.lifter, b.index, inside, std::sqrt(dx * dx + dy * dy)};
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+// The interval that a bar's corners cover along `axis`.
+std::pair<double, double> extent(const DrumGeometry::Bar& bar, Vec2 axis) {
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const Vec2 c : bar.corner) {
+    lo = std::min(lo, dot(c, axis));
+    hi = std::max(hi, dot(c, axis));
+  }
+  return {lo, hi};
+}
+
+}  // namespace
+
+// Separating axes: the sides of either rectangle. Bars that touch (up to rounding) are apart.
+bool DrumGeometry::bars_overlap(const Bar& a, const Bar& b) {
+  const double slack = 1e-12 * (norm(a.corner[0]) + norm(b.corner[0]));
+  for (const Bar* bar : {&a, &b}) {
+    const Vec2 radial{std::cos(bar->phi), std::sin(bar->phi)};
+    for (const Vec2 axis : {radial, perp(radial)}) {
+      const auto [a_lo, a_hi] = extent(a, axis);
+      const auto [b_lo, b_hi] = extent(b, axis);
+      if (a_hi <= b_lo + slack || b_hi <= a_lo + slack) return false;
+    }
+  }
+  return true;
+}
+
+int DrumGeometry::bars_that_fit(std::size_t lifter) const {
+  const LifterSpec& l = drum_.lifters[lifter];
+  const double top = inner_ - l.height;
+  if (!(top > 0.0)) return 1;  // the bars reach the axis: any two meet there
+  const double span = 2.0 * std::atan(0.5 * l.width / top);
+  const double fit = std::floor(2.0 * std::numbers::pi / span);  // bars 2 pi / n >= span apart
+  return static_cast<int>(std::clamp(fit, 1.0, double{INT_MAX}));
+}
+
+std::optional<std::pair<std::size_t, std::size_t>> DrumGeometry::overlapping_sets() const {
+  for (std::size_t m = 1; m < drum_.lifters.size(); ++m) {
+    for (std::size_t l = 0; l < m; ++l) {
+      if (const auto pair = overlap_between(l, m)) return pair;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::pair<std::size_t, std::size_t>> DrumGeometry::overlap_between(
+    std::size_t l, std::size_t m) const {
+  const long n = drum_.lifters[l].count;
+  if (n <= 0) return std::nullopt;
+  const double spacing = 2.0 * std::numbers::pi / static_cast<double>(n);
+  const std::size_t end = first_bar_[m] + static_cast<std::size_t>(drum_.lifters[m].count);
+  for (std::size_t j = first_bar_[m]; j < end; ++j) {
+    const auto below =
+        static_cast<long>(std::floor((bars_[j].phi - drum_.lifters[l].angle) / spacing));
+    for (const long k : {below, below + 1}) {
+      const std::size_t i = first_bar_[l] + static_cast<std::size_t>(((k % n) + n) % n);
+      if (bars_overlap(bars_[i], bars_[j])) return std::pair{i, j};
+    }
   }
   return std::nullopt;
 }

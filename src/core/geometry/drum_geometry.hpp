@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/base/scene.hpp"
@@ -68,11 +69,27 @@ class DrumGeometry {
   // r overlaps (closer to the bar than r, or inside it), or nullopt.
   std::optional<LifterOverlap> bar_overlap(Vec2 x, double r) const;
 
+  // Whether two bars overlap: their rectangles, from the feet to the top faces, share more than
+  // an edge (bars that only touch do not overlap).
+  static bool bars_overlap(const Bar& a, const Bar& b);
+  // The most bars of lifter set `lifter`'s width and height that stand around the shell, evenly
+  // spaced, without overlapping: a bar spans 2 atan(half width / top) seen from the centre, at
+  // its top corners, and n bars are 2 pi / n apart.
+  int bars_that_fit(std::size_t lifter) const;
+  // Two bars of different lifter sets that overlap, as indices into bars(), or nullopt.
+  std::optional<std::pair<std::size_t, std::size_t>> overlapping_sets() const;
+
  private:
   DrumSpec drum_;
   double inner_ = 0.0, tallest_ = 0.0;
   std::vector<Vec2> side_normals_;  // the polygon's outward side normals at t = 0
+  // A bar of set m that overlaps one of set l (each bar of m against the bars of l nearest to it
+  // on either side), as indices into bars_.
+  std::optional<std::pair<std::size_t, std::size_t>> overlap_between(std::size_t l,
+                                                                     std::size_t m) const;
+
   std::vector<Bar> bars_;
+  std::vector<std::size_t> first_bar_;  // per lifter set, its first bar in bars_
 };
 
 }  // namespace dem2d

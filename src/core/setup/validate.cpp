@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/errors.hpp"
@@ -318,7 +320,13 @@ void validate_start(const Scene& scene, const ParticleStore& particles, double d
   check_particles(scene, step, errors);
   check_walls(scene, smallest_radius(scene, particles), step, errors);
   const double steps = scene.run.duration / dt;
-  if (steps > kMaxRunSteps) {
+  if (!(steps > 0.5)) {  // the run loop steps while t + dt / 2 < duration
+    errors.push_back(error_at(scene, "run.duration",
+                              " = " + num(scene.run.duration) + " s is " + num(steps, 3) +
+                                  " of a step of " + step.dt_text() +
+                                  " and rounds to no step: the run would do nothing; the "
+                                  "duration must be at least one step"));
+  } else if (steps > kMaxRunSteps) {
     errors.push_back(error_at(
         scene, "run.duration",
         " = " + num(scene.run.duration) + " s is " + num(steps, 3) + " steps of " + step.dt_text() +
@@ -328,6 +336,23 @@ void validate_start(const Scene& scene, const ParticleStore& particles, double d
             (scene.run.dt_auto ? std::string() : ", or give a larger run.dt")));
   }
   if (!errors.empty()) throw InputError(errors);
+}
+
+std::vector<std::string> output_interval_notes(const Scene& scene, double dt) {
+  std::vector<std::string> notes;
+  if (!(dt > 0.0)) return notes;
+  const OutputSpec& out = scene.output;
+  const std::pair<const char*, double> intervals[] = {
+      {"output.series_interval", out.series_interval},
+      {"output.snapshot_interval", out.snapshot_interval},
+      {"output.checkpoint_interval", out.checkpoint_interval}};
+  for (const auto& [key, interval] : intervals) {
+    if (!scene.where.contains(key) || !(interval > 0.0) || interval >= dt) continue;
+    notes.push_back(where(scene, key) + ": note: " + key + " = " + num(interval) +
+                    " s is shorter than one step, " + StepMotion(scene, dt).dt_text() +
+                    ": written every step (an output comes at most once a step)");
+  }
+  return notes;
 }
 
 }  // namespace dem2d

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "core/base/scene.hpp"
 #include "core/base/vec2.hpp"
@@ -61,8 +62,14 @@ void check_memory(const Scene& scene, double available);
 // Throws InputError when, at time step `dt`, a particle's initial velocity (or spin, turning
 // its surface) would carry it more than kMaxStepMotion of its radius in the first step, when
 // the fed particles, a [[wall]] or the drum's shell would move that far against the smallest
-// particle, or when run.duration / dt exceeds kMaxRunSteps. `particles`: every particle as
-// placed (ids are their indices: [[particle]] tables, file rows, then the fills).
+// particle, or when run.duration / dt rounds to no step or exceeds kMaxRunSteps. `particles`: every
+// particle as placed (ids are their indices: [[particle]] tables, file rows, then the fills).
 void validate_start(const Scene& scene, const ParticleStore& particles, double dt);
+
+// The output intervals the deck gives (series, snapshots, checkpoints) that are shorter than
+// `dt`: an output comes at most once a step, so each is written every step. One note per key,
+// "WHERE: note: output.series_interval = 1e-05 s is shorter than one step, dt = ...: written
+// every step ...", for the command line to print.
+std::vector<std::string> output_interval_notes(const Scene& scene, double dt);
 
 }  // namespace dem2d
