@@ -200,6 +200,8 @@ class Kernel final : public ContactKernel {
                     std::int32_t element, double dt, const double* h);
   void evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated, EightLanes& elastic,
                       Pack& overlap);
+  static KinematicsT<Pack> pair_kinematics(const PairContactT<Pack>& g, Pack mi, Pack mj, Pack ri,
+                                           Pack rj);
   void evaluate_pairs_apart(std::size_t n, double dt, EightLanes& dissipated, EightLanes& elastic,
                             Pack& overlap);
   // What one pack of pairs hands to the batch (put_pack).

@@ -141,6 +141,22 @@ std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList&
   return n;
 }
 
+// A pair's overlap, R*, reduced mass and (rolling models) reduced inertia about the contact point:
+// the harmonic mean of the two bodies'.
+template <class Model, class Shape>
+[[gnu::always_inline]] inline KinematicsT<Pack> Kernel<Model, Shape>::pair_kinematics(
+    const PairContactT<Pack>& g, Pack mi, Pack mj, Pack ri, Pack rj) {
+  KinematicsT<Pack> kin;
+  kin.delta = g.delta;
+  kin.r_eff = g.r_eff;
+  kin.m_eff = mi * mj / (mi + mj);
+  if constexpr (Model::Rolling::kNeedsInertia) {
+    const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
+    kin.i_eff = ia * ib / (ia + ib);
+  }
+  return kin;
+}
+
 // B. The contact model on packs of kPackSize contacts.
 template <class Model, class Shape>
 void Kernel<Model, Shape>::evaluate_pairs(std::size_t n, double dt, EightLanes& dissipated,
@@ -154,16 +170,7 @@ void Kernel<Model, Shape>::evaluate_pairs(std::size_t n, double dt, EightLanes& 
           Shape::pair(load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj);
       const Pack nx = g.nx, ny = g.ny;
       const Pack tx = -ny, ty = nx;
-      const Pack mi = load(b_.m_i, c), mj = load(b_.m_j, c);
-      KinematicsT<Pack> kin;
-      kin.delta = g.delta;
-      kin.r_eff = g.r_eff;
-      kin.m_eff = mi * mj / (mi + mj);
-      if constexpr (Model::Rolling::kNeedsInertia) {
-        // About the contact point; harmonic mean of the two bodies.
-        const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
-        kin.i_eff = ia * ib / (ia + ib);
-      }
+      KinematicsT<Pack> kin = pair_kinematics(g, load(b_.m_i, c), load(b_.m_j, c), ri, rj);
       const Pack spin = load(b_.spin, c);
       project_velocity(kin, load(b_.vx, c) + spin * tx, load(b_.vy, c) + spin * ty, nx, ny);
       kin.omega_rel = load(b_.omega_rel, c);
@@ -235,15 +242,7 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
     store(select(touching, load(b_.counted, c), zero), b_.counted, c);
     const Pack nx = g.nx, ny = g.ny;
     const Pack tx = -ny, ty = nx;
-    const Pack mi = load(b_.m_i, c), mj = load(b_.m_j, c);
-    KinematicsT<Pack> kin;
-    kin.delta = g.delta;
-    kin.r_eff = g.r_eff;
-    kin.m_eff = mi * mj / (mi + mj);
-    if constexpr (Model::Rolling::kNeedsInertia) {
-      const Pack ia = Shape::contact_inertia(mi, ri), ib = Shape::contact_inertia(mj, rj);
-      kin.i_eff = ia * ib / (ia + ib);
-    }
+    KinematicsT<Pack> kin = pair_kinematics(g, load(b_.m_i, c), load(b_.m_j, c), ri, rj);
     // (v_i + w_i x a_i) - (v_j + w_j x a_j), with w x a = w (-a_y, a_x).
     const Pack wi = load(b_.w_i, c), wj = load(b_.w_j, c);
     project_velocity(kin, load(b_.vx, c) - wi * g.aiy + wj * g.ajy,
