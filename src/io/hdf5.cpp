@@ -160,6 +160,12 @@ void ParallelFile::move_link(const std::string& from, const std::string& to) {
         "move link", from + "' to '" + to);
 }
 
+void ParallelFile::hard_link(const std::string& target, const std::string& link) {
+  check(H5Lcreate_hard(file_.get(), target.c_str(), file_.get(), link.c_str(), H5P_DEFAULT,
+                       H5P_DEFAULT),
+        "link", link + "' to '" + target);
+}
+
 void ParallelFile::remove_link(const std::string& name) {
   check(H5Ldelete(file_.get(), name.c_str(), H5P_DEFAULT), "remove link", name);
 }

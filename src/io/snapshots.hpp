@@ -50,8 +50,11 @@
 // message on every rank.
 #pragma once
 
+#include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -147,9 +150,11 @@ class SnapshotWriter {
 
   const std::string& h5_path() const { return h5_path_; }
   const std::string& xdmf_path() const;
-  // The snapshots under /snapshots, in order: those written, after those a resume kept.
-  const std::vector<SnapshotInfo>& snapshots() const { return records_; }
-  std::size_t snapshots_written() const { return records_.size(); }
+  // The snapshots under /snapshots: those a resume kept and those written since.
+  std::size_t snapshots_written() const { return written_; }
+  // The last of them (std::nullopt while there is none). The writer keeps no other record of
+  // the snapshots before it: its memory does not grow with their number.
+  const std::optional<SnapshotInfo>& last_snapshot() const { return last_; }
 
   // Testing only (tests/io): the next write() throws IoError on every rank, as a full disk
   // would, just before it writes dataset number `datasets` (0: the first) of its staging
@@ -162,6 +167,13 @@ class SnapshotWriter {
  private:
   struct NoFile {};  // the constructors' common part: the paths, no file opened yet
   struct WallData;   // an outline as written: points and segments
+  // A dataset stored only when it changes (a stable field, the wall outline's points and
+  // segments): its published name and this rank's rows and bytes, as last stored.
+  struct Stored {
+    std::string path;
+    h5::RowRange rows;
+    std::vector<std::byte> bytes;
+  };
   static WallData wall_data(std::span<const std::vector<Vec2>> outlines);
   SnapshotWriter(NoFile, MPI_Comm comm, const std::string& directory);
   SnapshotInfo describe(const ParticleStore& p, double time, std::int64_t step,
@@ -170,15 +182,23 @@ class SnapshotWriter {
   void clear_failed_write(const std::string& name);
   void stage(const std::string& group, const SnapshotInfo& record, const h5::RowRange& rows,
              const ParticleStore& p, std::span<const ExtraField> extra, const WallData& walls);
-  void write_datasets(const std::string& group, const h5::RowRange& rows, const ParticleStore& p,
+  std::optional<std::vector<SnapshotInfo>> publish(const SnapshotInfo& record, bool sync);
+  bool link_if_unchanged(const std::string& key, const std::string& staged,
+                         const std::string& published, const h5::RowRange& rows, const void* data,
+                         std::size_t bytes);
+  std::vector<SnapshotInfo> published_records() const;
+  void read_walls(SnapshotInfo& record) const;
+  void sync_due(std::array<int, 3>& header);
+  void write_datasets(const std::string& group, const std::string& published,
+                      const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
   void write_polyvertex(const h5::RowRange& rows);
   void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
-  void agree(const std::string& local_error);  // IoError on every rank if any failed
-  void drop_and_read(double last_time);        // resume: the file's part
-  std::optional<SnapshotInfo> read_record(const std::string& name, double last_time);
-  void reconcile_polyvertex();
-  void reconcile_walls();
+  void agree(const std::string& local_error);                 // IoError on every rank if any failed
+  std::vector<SnapshotInfo> drop_and_read(double last_time);  // resume: the file's part
+  std::optional<SnapshotInfo> read_record(const std::string& name, double last_time) const;
+  void reconcile_polyvertex(const std::vector<SnapshotInfo>& kept);
+  void reconcile_walls(std::vector<SnapshotInfo>& kept);
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -186,7 +206,12 @@ class SnapshotWriter {
   std::unique_ptr<XdmfSidecar> xdmf_;  // snapshots.xmf, kept by rank 0 (xdmf.hpp)
   std::optional<h5::ParallelFile> file_;
   std::vector<std::string> material_names_;  // /materials/name: snapshots.xmf names them
-  std::vector<SnapshotInfo> records_;
+  std::optional<SnapshotInfo> last_;         // the last snapshot under /snapshots
+  std::size_t written_ = 0;                  // snapshots under /snapshots
+  std::map<std::string, Stored> stored_;     // by field name, or "walls/points", ...
+  std::map<std::string, Stored> pending_;    // this write's new ones: stored_ once published
+  std::chrono::steady_clock::time_point last_sync_ = std::chrono::steady_clock::now();
+  bool closed_ = false;                       // close() was called
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
   bool failed_ = false;                       // the last write failed: clear its remains first
