@@ -287,6 +287,7 @@ std::optional<std::vector<SnapshotInfo>> SnapshotWriter::publish(const SnapshotI
     if (rank_ == 0 && !xdmf_->can_append()) whole = published_records();
     file_->close();  // every snapshot's metadata in the file: a reader (or a kill) sees it whole
     file_.reset();
+    H5garbage_collect();  // HDF5's free lists, grown by this file's metadata, back to the heap
   } catch (const IoError& e) {
     error = e.what();
   }

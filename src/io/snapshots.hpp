@@ -13,11 +13,16 @@
 //       field's FieldMeta (`material` also `names`, "0=steel,1=ore"); then `speed` (|velocity|,
 //       m/s); then any extra fields. The group tracks the creation order of its datasets
 //       (resume() reads them back in that order). Only per-particle datasets: post/*.py and
-//       the tests read every member as N rows.
+//       the tests read every member as N rows. A field marked `stable` (id, material, radius)
+//       whose rows on every rank are those it stored last is not stored again: the member is a
+//       hard link to the stored dataset (one object, two names; readers see no difference).
 //   /walls/NNNNNN                        the wall outline at snapshot NNNNNN's time, when write()
 //                                        was given one: attributes time, step;
 //       points   (M x 2 double, m)       the outline's points in the lab frame
 //       segments (S x 2 int64)           the straight pieces, as pairs of rows of `points`
+//                                        each a hard link to the last stored one when equal to
+//                                        it (the segments of a scene: always; the points: while
+//                                        the walls stand still)
 //   /incomplete/NNNNNN, /incomplete/walls_NNNNNN
 //                                        the snapshot being written and its outline (staging);
 //                                        empty between writes, except after a failed write
@@ -25,12 +30,17 @@
 //                                        its Polyvertex topology (one per particle count N)
 // N is the global number of owned particles; rank 0's particles come first, then rank 1's...
 //
-// Complete or absent. write() builds the snapshot in /incomplete/NNNNNN and its outline in
-// /incomplete/walls_NNNNNN, flushes the file, then moves the outline's link to /walls/NNNNNN
-// and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and flushes again. A
-// write that fails part-way (disk full) leaves at most partial groups under /incomplete, never
-// under /snapshots: everything under /snapshots is a complete snapshot. Readers (post/*.py)
-// list /snapshots only.
+// Complete or absent. write() opens the file (MPI-IO, collectively), builds the snapshot in
+// /incomplete/NNNNNN and its outline in /incomplete/walls_NNNNNN, moves the outline's link to
+// /walls/NNNNNN and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and closes
+// the file, which writes out all of its metadata; only then does rank 0 list the snapshot in
+// snapshots.xmf. Between writes the file is closed and whole, so a run killed then leaves every
+// listed snapshot readable. A write that fails part-way (disk full) leaves at most partial
+// groups under /incomplete, never under /snapshots: everything under /snapshots is a complete
+// snapshot. Readers (post/*.py) list /snapshots only. Syncing to disk (fsync) is what a
+// snapshot would otherwise cost most: write() syncs both files (H5Fflush before the close, then
+// snapshots.xmf and the folder) only when kSyncInterval of wall time (rank 0's clock) has
+// passed since the last sync, and close() syncs them at the end.
 //
 // snapshots.xmf (XDMF 3): a temporal collection with, per snapshot, a spatial collection at its
 // time of two grids: "particles", a Polyvertex grid with XY geometry from position, every
@@ -138,14 +148,15 @@ class SnapshotWriter {
   // Writes the owned particles [0, n_owned()) as the next snapshot, with the wall outline
   // `walls` (polylines in the lab frame at `time`, e.g. core/geometry/walls.hpp's wall_outlines;
   // rank 0's are written, every rank passes the same; none: no /walls group, no "walls" grid):
-  // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, flush, move to /walls/NNNNNN and
-  // /snapshots/NNNNNN, flush; then rank 0 appends its grid to snapshots.xmf. After a failed
-  // write (IoError) the writer may write again: the next write first removes what the failed
+  // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, moved to /walls/NNNNNN and
+  // /snapshots/NNNNNN, the file closed; then rank 0 appends its grid to snapshots.xmf. After a
+  // failed write (IoError) the writer may write again: the next write first removes what the failed
   // one left and reuses its number if it did not reach /snapshots.
   void write(const ParticleStore& particles, double time, std::int64_t step,
              std::span<const std::vector<Vec2>> walls = {}, std::span<const ExtraField> extra = {});
 
-  // Closes the file and reports a failure (the destructor cannot). Later writes are errors.
+  // Syncs snapshots.h5, snapshots.xmf and the folder to disk and reports a failure (the
+  // destructor neither syncs nor reports). Later writes are errors.
   void close();
 
   const std::string& h5_path() const { return h5_path_; }
@@ -159,9 +170,9 @@ class SnapshotWriter {
   // Testing only (tests/io): the next write() throws IoError on every rank, as a full disk
   // would, just before it writes dataset number `datasets` (0: the first) of its staging
   // group (snapshot_datasets, then the extra fields), or, when the snapshot has no more
-  // datasets than that, after the last one and the wall outline (before the flush and the
-  // moves); the message ends in "injected failure". It costs a write nothing when not armed.
-  // Collective: call it on every rank.
+  // datasets than that, after the last one and the wall outline (before the moves); the message
+  // ends in "injected failure". It costs a write nothing when not armed. Collective: call it on
+  // every rank.
   void fail_before_dataset_for_testing(std::size_t datasets) { fail_before_dataset_ = datasets; }
 
  private:
