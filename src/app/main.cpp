@@ -175,6 +175,7 @@ int run(const Options& opt) {
   const std::int64_t first_step = sim.step_count();
   RunLoop loop(sim, scene, domain, series, *snapshots, resumed);
   const Ending ending = loop.run(progress);
+  snapshots->close();  // synced to disk (docs/output.md, "Crash safety")
   if (ending == Ending::kUnstable) return kExitUnstable;
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   const RunInfo info = run_info(

@@ -123,6 +123,10 @@ class ParallelFile {
   // Collective: renames the link `from` to `to` (absolute paths; H5Lmove, the object is not
   // copied). The parent group of `to` must exist.
   void move_link(const std::string& from, const std::string& to);
+  // Collective: a second name `link` (absolute path) for the existing object `target` (a hard
+  // link, H5Lcreate_hard: the object is stored once and stays while any of its names does).
+  // The parent group of `link` must exist.
+  void hard_link(const std::string& target, const std::string& link);
   // Collective: removes the link `name` (H5Ldelete). The object's space in the file is not
   // reclaimed.
   void remove_link(const std::string& name);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <optional>
 #include <stdexcept>
@@ -36,6 +37,9 @@ using snapshot_layout::polyvertex_dataset;
 // The derived dataset every snapshot holds after the registry's: |velocity|.
 const SnapshotDataset kSpeed{"speed", "double", 1, "m/s",
                              "speed of the centre, the norm of velocity"};
+
+// A write syncs the files to disk (fsync) when this long has passed since the last sync.
+constexpr std::chrono::seconds kSyncInterval{10};
 
 // The group of the snapshot being written (snapshots.h5's other groups: snapshot_layout.hpp).
 const std::string kStagingGroup = "/incomplete";
@@ -107,10 +111,11 @@ SnapshotWriter::SnapshotWriter(MPI_Comm comm, const std::string& directory,
     file_->create_group(kWallsGroup);
     file_->create_group(kStagingGroup);
     file_->create_group(kXdmfGroup);
-    file_->flush();
+    file_->close();  // reopened by each write
   } catch (const IoError& e) {
     error = e.what();
   }
+  file_.reset();
   mpi::agree_on_failure<IoError>(comm_, error);
 }
 
@@ -126,17 +131,22 @@ std::unique_ptr<SnapshotWriter> SnapshotWriter::resume(MPI_Comm comm, const std:
   if (mpi::broadcast_string(comm, found, 0).empty())
     return std::make_unique<SnapshotWriter>(comm, directory, materials);
   std::unique_ptr<SnapshotWriter> w(new SnapshotWriter(NoFile{}, comm, directory));
+  std::vector<SnapshotInfo> kept;
   std::string error;
   try {
     w->file_.emplace(h5::ParallelFile::open(comm, path));
-    w->drop_and_read(time + tolerance);
-    w->file_->flush();
+    kept = w->drop_and_read(time + tolerance);
+    w->file_->flush();  // the file as the restart left it, on disk
+    w->file_->close();
   } catch (const IoError& e) {
     error = e.what();
   }
   w->agree(error);
-  if (w->rank_ == 0) error = w->xdmf_->rewrite(w->records_, w->material_names_);
+  w->file_.reset();
+  if (w->rank_ == 0) error = w->xdmf_->rewrite(kept, w->material_names_);
   w->agree(error);
+  w->written_ = kept.size();
+  if (!kept.empty()) w->last_ = std::move(kept.back());
   return w;
 }
 
@@ -208,17 +218,26 @@ SnapshotWriter::WallData SnapshotWriter::wall_data(std::span<const std::vector<V
   return w;
 }
 
+// rank 0's outline rows and whether this write syncs the file to disk (rank 0's clock), for
+// every rank: `header` is {points, segments, sync}.
+void SnapshotWriter::sync_due(std::array<int, 3>& header) {
+  const auto now = std::chrono::steady_clock::now();
+  header[2] = now - last_sync_ >= kSyncInterval ? 1 : 0;
+  mpi::broadcast(comm_, header, 0);
+  if (header[2] != 0) last_sync_ = now;
+}
+
 void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
                            std::span<const std::vector<Vec2>> walls,
                            std::span<const ExtraField> extra) {
-  if (!file_) throw std::logic_error("SnapshotWriter::write after close");
+  if (closed_) throw std::logic_error("SnapshotWriter::write after close");
   SnapshotInfo record = describe(p, time, step, extra);
   const WallData outline = wall_data(walls);
-  std::array<int, 2> wall_rows{static_cast<int>(outline.points.size() / 2),
-                               static_cast<int>(outline.segments.size() / 2)};
-  mpi::broadcast(comm_, wall_rows, 0);  // rank 0's outline is written
-  record.wall_points = static_cast<std::uint64_t>(wall_rows[0]);
-  record.wall_segments = static_cast<std::uint64_t>(wall_rows[1]);
+  std::array<int, 3> header{static_cast<int>(outline.points.size() / 2),
+                            static_cast<int>(outline.segments.size() / 2), 0};
+  sync_due(header);  // rank 0's outline is written
+  record.wall_points = static_cast<std::uint64_t>(header[0]);
+  record.wall_segments = static_cast<std::uint64_t>(header[1]);
   std::uint64_t row_bytes = 0;
   for (const SnapshotDataset& d : record.datasets)
     row_bytes += d.columns * (d.type == "int32" ? 4 : 8);
@@ -226,38 +245,62 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   ensure_free_space(comm_, h5_path_,
                     total * row_bytes + 16 * (record.wall_points + record.wall_segments) +
                         2048 * (record.datasets.size() + 2) + 16384);
-  const std::string staged = kStagingGroup + "/" + record.name;
-  const std::string published = kSnapshotsGroup + "/" + record.name;
   std::string error;
   try {
+    if (!file_) file_.emplace(h5::ParallelFile::open(comm_, h5_path_));
     if (failed_) clear_failed_write(record.name);
     const h5::RowRange rows = h5::row_range(comm_, p.n_owned());
     record.particles = rows.total;
-    stage(staged, record, rows, p, extra, outline);
+    stage(kStagingGroup + "/" + record.name, record, rows, p, extra, outline);
   } catch (const IoError& e) {
     error = e.what();
   }
   agree(error);
+  const bool sync = header[2] != 0;
+  std::optional<std::vector<SnapshotInfo>> whole = publish(record, sync);
+  if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
+  last_ = record;
+  ++written_;
+  ++next_index_;
+  if (rank_ == 0) {  // the sidecar lists the snapshot only now that the closed file holds it
+    error =
+        whole ? xdmf_->rewrite(*whole, material_names_) : xdmf_->append(record, material_names_);
+    if (error.empty() && sync) error = xdmf_->sync();
+  }
+  agree(error);
+}
+
+// Moves the staged snapshot and its outline to /snapshots and /walls and closes the file (its
+// metadata written out; synced to disk only when `sync`). Returns, on rank 0 when snapshots.xmf
+// must be written whole, every snapshot the file now holds.
+std::optional<std::vector<SnapshotInfo>> SnapshotWriter::publish(const SnapshotInfo& record,
+                                                                 bool sync) {
+  std::optional<std::vector<SnapshotInfo>> whole;
+  std::string error;
   try {
     if (record.wall_segments > 0)  // the outline first: a published snapshot has its outline
       file_->move_link(staged_walls(record.name), kWallsGroup + "/" + record.name);
-    file_->move_link(staged, published);  // complete: readers may see it from now on
-    file_->flush();                       // a crash later still leaves this snapshot readable
+    file_->move_link(kStagingGroup + "/" + record.name, kSnapshotsGroup + "/" + record.name);
+    for (auto& [key, stored] : pending_) stored_[key] = std::move(stored);
+    pending_.clear();
+    if (sync) file_->flush();  // H5Fflush: MPI_File_sync, an fsync
+    if (rank_ == 0 && !xdmf_->can_append()) whole = published_records();
+    file_->close();  // every snapshot's metadata in the file: a reader (or a kill) sees it whole
+    file_.reset();
+    H5garbage_collect();  // HDF5's free lists, grown by this file's metadata, back to the heap
   } catch (const IoError& e) {
     error = e.what();
   }
   agree(error);
-  if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
-  records_.push_back(std::move(record));
-  ++next_index_;
-  if (rank_ == 0) error = xdmf_->append(records_, material_names_);
-  agree(error);
+  return whole;
 }
 
 void SnapshotWriter::agree(const std::string& local_error) {
   std::string message = mpi::first_failure(comm_, local_error);
   if (message.empty()) return;
   failed_ = true;
+  pending_.clear();
+  file_.reset();  // on every rank (a collective close, errors ignored): the next write reopens it
   throw IoError(message);
 }
 
@@ -266,8 +309,10 @@ void SnapshotWriter::agree(const std::string& local_error) {
 // recorded; a connectivity dataset no recorded snapshot uses), so the write can start afresh.
 void SnapshotWriter::clear_failed_write(const std::string& name) {
   for (const std::string& g : {kStagingGroup + "/" + name, staged_walls(name),
-                               kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name})
+                               kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name}) {
     if (file_->link_exists(g)) file_->remove_link(g);
+    std::erase_if(stored_, [&](const auto& s) { return s.second.path.starts_with(g + "/"); });
+  }
   for (const std::string& member : file_->group_members(kXdmfGroup)) {
     const std::optional<std::uint64_t> n = polyvertex_size(member);
     if (n && !polyvertex_sizes_.contains(*n)) file_->remove_link(kXdmfGroup + "/" + member);
@@ -276,28 +321,59 @@ void SnapshotWriter::clear_failed_write(const std::string& name) {
 }
 
 // The snapshot as the staging group `group`, with the connectivity it needs and its wall
-// outline (staged_walls), flushed.
+// outline (staged_walls).
 void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
                            const h5::RowRange& rows, const ParticleStore& p,
                            std::span<const ExtraField> extra, const WallData& walls) {
   file_->create_group(group, /*track_order=*/true);  // resume() reads the datasets in order
   file_->write_attribute(group, "time", record.time);
   file_->write_attribute(group, "step", record.step);
-  write_datasets(group, rows, p, extra);
+  write_datasets(group, kSnapshotsGroup + "/" + record.name, rows, p, extra);
   if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) write_polyvertex(rows);
   if (record.wall_segments > 0) write_walls(staged_walls(record.name), record, walls);
   if (fail_before_dataset_) {  // testing: past the last dataset, fail before the flush
     fail_before_dataset_.reset();
-    throw IoError(fmt::format("{}: cannot flush '{}': injected failure", h5_path_, group));
+    throw IoError(fmt::format("{}: cannot close '{}': injected failure", h5_path_, group));
   }
-  file_->flush();
 }
+
+// Whether the dataset `key` (this write's rows `data`, `bytes` long on this rank) is unchanged
+// since it was last stored, on every rank: then `staged` becomes a second name (a hard link) of
+// the stored dataset and true is returned. Otherwise the caller writes it at `staged`, and it is
+// the one stored under `published` once this snapshot is published.
+bool SnapshotWriter::link_if_unchanged(const std::string& key, const std::string& staged,
+                                       const std::string& published, const h5::RowRange& rows,
+                                       const void* data, std::size_t bytes) {
+  const auto it = stored_.find(key);
+  const bool same = it != stored_.end() && it->second.rows.offset == rows.offset &&
+                    it->second.rows.count == rows.count && it->second.rows.total == rows.total &&
+                    it->second.bytes.size() == bytes &&
+                    (bytes == 0 || std::memcmp(it->second.bytes.data(), data, bytes) == 0);
+  if (!mpi::any(comm_, !same)) {
+    file_->hard_link(it->second.path, staged);
+    return true;
+  }
+  const auto* first = static_cast<const std::byte*>(data);
+  pending_[key] = Stored{published, rows, std::vector<std::byte>(first, first + bytes)};
+  return false;
+}
+
+namespace {
+
+// The bytes of this rank's rows of a particle field as a dataset holds them.
+std::size_t field_bytes(const h5::FieldColumn& c, const h5::RowRange& rows) {
+  return rows.count * c.columns * (c.element == h5::FieldColumn::kInt32 ? 4 : 8);
+}
+
+}  // namespace
 
 // The registry's snapshot fields in registry order, then speed, then the extra fields; each
 // dataset with its unit and description as attributes, so a file explains itself, and the
-// material rows with the material names (attribute `names`, "0=steel,1=ore").
-void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange& rows,
-                                    const ParticleStore& p, std::span<const ExtraField> extra) {
+// material rows with the material names (attribute `names`, "0=steel,1=ore"). A stable field
+// whose rows are those last stored is linked to them (link_if_unchanged), not written again.
+void SnapshotWriter::write_datasets(const std::string& group, const std::string& published,
+                                    const h5::RowRange& rows, const ParticleStore& p,
+                                    std::span<const ExtraField> extra) {
   std::size_t written = 0;
   const auto begin = [&](const std::string& name) {  // fail_before_dataset_for_testing
     if (fail_before_dataset_ && *fail_before_dataset_ == written++) {
@@ -314,7 +390,11 @@ void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange
     if (!f->meta().snapshot) continue;
     const std::string name = group + "/" + f->name();
     begin(name);
-    file_->write_field(name, rows, *f);  // snapshot_datasets checked the type
+    const h5::FieldColumn c = *h5::field_column(*f);  // snapshot_datasets checked the type
+    if (f->meta().stable && link_if_unchanged(f->name(), name, published + "/" + f->name(), rows,
+                                              c.data, field_bytes(c, rows)))
+      continue;
+    file_->write_field(name, rows, *f);
     describe(name, f->meta().unit, f->meta().doc);
     if (f->name() == kMaterial)
       file_->write_attribute(name, "names", material_lookup(material_names_));
@@ -334,22 +414,33 @@ void SnapshotWriter::write_datasets(const std::string& group, const h5::RowRange
 }
 
 // The wall outline of snapshot `record` as the group `group`: its time and step, the points
-// (M x 2) and the segments (S x 2 point rows); rank 0's, the same on every rank.
+// (M x 2) and the segments (S x 2 point rows); rank 0's, the same on every rank. Points or
+// segments equal to those last stored are linked to them (link_if_unchanged): the segments of
+// a scene are written once, its points again only when the walls have moved.
 void SnapshotWriter::write_walls(const std::string& group, const SnapshotInfo& record,
                                  const WallData& walls) {
   file_->create_group(group);
   file_->write_attribute(group, "time", record.time);
   file_->write_attribute(group, "step", record.step);
+  const std::string published = kWallsGroup + "/" + record.name;
+  const h5::RowRange point_rows = h5::rank0_rows(comm_, record.wall_points);
   const std::string points = group + "/points";
-  file_->write_rows(points, h5::rank0_rows(comm_, record.wall_points), walls.points.data(), 2);
-  file_->write_attribute(points, "unit", std::string("m"));
-  file_->write_attribute(points, "doc", std::string("x and y of the outline's points, lab frame"));
+  if (!link_if_unchanged("walls/points", points, published + "/points", point_rows,
+                         walls.points.data(), point_rows.count * 16)) {
+    file_->write_rows(points, point_rows, walls.points.data(), 2);
+    file_->write_attribute(points, "unit", std::string("m"));
+    file_->write_attribute(points, "doc",
+                           std::string("x and y of the outline's points, lab frame"));
+  }
+  const h5::RowRange segment_rows = h5::rank0_rows(comm_, record.wall_segments);
   const std::string segments = group + "/segments";
-  file_->write_rows(segments, h5::rank0_rows(comm_, record.wall_segments), walls.segments.data(),
-                    2);
-  file_->write_attribute(segments, "unit", std::string("1"));
-  file_->write_attribute(segments, "doc",
-                         std::string("rows of `points` joined by each straight piece"));
+  if (!link_if_unchanged("walls/segments", segments, published + "/segments", segment_rows,
+                         walls.segments.data(), segment_rows.count * 16)) {
+    file_->write_rows(segments, segment_rows, walls.segments.data(), 2);
+    file_->write_attribute(segments, "unit", std::string("1"));
+    file_->write_attribute(segments, "doc",
+                           std::string("rows of `points` joined by each straight piece"));
+  }
 }
 
 // /xdmf/polyvertex_N for N = rows.total: 0, 1, ..., N - 1, each rank writing its rows.
@@ -362,7 +453,7 @@ void SnapshotWriter::write_polyvertex(const h5::RowRange& rows) {
 
 // resume(): empties /incomplete, drops the snapshots after `last_time`, records the others in
 // order and makes /xdmf hold exactly the connectivity they use.
-void SnapshotWriter::drop_and_read(double last_time) {
+std::vector<SnapshotInfo> SnapshotWriter::drop_and_read(double last_time) {
   if (!file_->link_exists(kSnapshotsGroup))
     throw IoError(fmt::format("{}: cannot resume: no {} group", h5_path_, kSnapshotsGroup));
   material_names_ = file_->read_strings("/materials/name");
@@ -383,22 +474,41 @@ void SnapshotWriter::drop_and_read(double last_time) {
     groups.emplace_back(*index, name);
   }
   std::sort(groups.begin(), groups.end());
+  std::vector<SnapshotInfo> kept;
   for (const auto& [index, name] : groups) {
     std::optional<SnapshotInfo> record = read_record(name, last_time);
     if (!record) {
       file_->remove_link(kSnapshotsGroup + "/" + name);
       continue;
     }
-    records_.push_back(std::move(*record));
+    kept.push_back(std::move(*record));
     next_index_ = index + 1;
   }
-  reconcile_polyvertex();
-  reconcile_walls();
+  reconcile_polyvertex(kept);
+  reconcile_walls(kept);
+  return kept;
+}
+
+// Every snapshot under /snapshots in order, with its outline: what snapshots.xmf lists when it
+// is written whole. Rank 0 alone reads them (the writer keeps no list).
+std::vector<SnapshotInfo> SnapshotWriter::published_records() const {
+  std::vector<std::pair<std::uint64_t, std::string>> groups;
+  for (const std::string& name : file_->group_members(kSnapshotsGroup))
+    if (const std::optional<std::uint64_t> index = snapshot_index(name))
+      groups.emplace_back(*index, name);
+  std::sort(groups.begin(), groups.end());
+  std::vector<SnapshotInfo> out;
+  for (const auto& [index, name] : groups) {
+    out.push_back(*read_record(name, std::numeric_limits<double>::infinity()));
+    if (file_->link_exists(kWallsGroup + "/" + name)) read_walls(out.back());
+  }
+  return out;
 }
 
 // The snapshot /snapshots/NAME as the file holds it; std::nullopt when its time is after
 // `last_time`. Throws IoError for a group that is not a snapshot dem2d wrote.
-std::optional<SnapshotInfo> SnapshotWriter::read_record(const std::string& name, double last_time) {
+std::optional<SnapshotInfo> SnapshotWriter::read_record(const std::string& name,
+                                                        double last_time) const {
   const std::string group = kSnapshotsGroup + "/" + name;
   SnapshotInfo r{name, file_->read_double_attribute(group, "time"), 0, 0, {}};
   if (r.time > last_time) return std::nullopt;
@@ -426,35 +536,40 @@ std::optional<SnapshotInfo> SnapshotWriter::read_record(const std::string& name,
 
 // resume(): records the wall outline of every kept snapshot that has one and removes the
 // others (those of dropped snapshots, or left by a write that failed between its moves).
-void SnapshotWriter::reconcile_walls() {
-  std::map<std::string, SnapshotInfo*> kept;
-  for (SnapshotInfo& r : records_) kept[r.name] = &r;
+void SnapshotWriter::reconcile_walls(std::vector<SnapshotInfo>& kept) {
+  std::map<std::string, SnapshotInfo*> by_name;
+  for (SnapshotInfo& r : kept) by_name[r.name] = &r;
   for (const std::string& member : file_->group_members(kWallsGroup)) {
-    const std::string group = kWallsGroup + "/" + member;
-    const auto it = kept.find(member);
-    if (it == kept.end()) {
-      file_->remove_link(group);
-      continue;
-    }
-    const bool complete =
-        file_->link_exists(group + "/points") && file_->link_exists(group + "/segments");
-    const h5::ParallelFile::DatasetShape points =
-        complete ? file_->dataset_shape(group + "/points") : h5::ParallelFile::DatasetShape{};
-    const h5::ParallelFile::DatasetShape segments =
-        complete ? file_->dataset_shape(group + "/segments") : h5::ParallelFile::DatasetShape{};
-    if (!complete || points.type != "double" || points.columns != 2 || segments.type != "int64" ||
-        segments.columns != 2 || segments.rows == 0)
-      throw IoError(fmt::format("{}: cannot resume: '{}' is not a wall outline", h5_path_, group));
-    it->second->wall_points = points.rows;
-    it->second->wall_segments = segments.rows;
+    const auto it = by_name.find(member);
+    if (it == by_name.end())
+      file_->remove_link(kWallsGroup + "/" + member);
+    else
+      read_walls(*it->second);
   }
+}
+
+// The rows of /walls/NAME's points and segments into `record` (NAME its name). Throws IoError
+// for a group that is not a wall outline.
+void SnapshotWriter::read_walls(SnapshotInfo& record) const {
+  const std::string group = kWallsGroup + "/" + record.name;
+  const bool complete =
+      file_->link_exists(group + "/points") && file_->link_exists(group + "/segments");
+  const h5::ParallelFile::DatasetShape points =
+      complete ? file_->dataset_shape(group + "/points") : h5::ParallelFile::DatasetShape{};
+  const h5::ParallelFile::DatasetShape segments =
+      complete ? file_->dataset_shape(group + "/segments") : h5::ParallelFile::DatasetShape{};
+  if (!complete || points.type != "double" || points.columns != 2 || segments.type != "int64" ||
+      segments.columns != 2 || segments.rows == 0)
+    throw IoError(fmt::format("{}: cannot resume: '{}' is not a wall outline", h5_path_, group));
+  record.wall_points = points.rows;
+  record.wall_segments = segments.rows;
 }
 
 // resume(): keeps the /xdmf/polyvertex_N the kept snapshots use (an unused one may be what a
 // crash left half-written), removes the others and writes any that is missing.
-void SnapshotWriter::reconcile_polyvertex() {
+void SnapshotWriter::reconcile_polyvertex(const std::vector<SnapshotInfo>& kept) {
   std::set<std::uint64_t> used;
-  for (const SnapshotInfo& r : records_)
+  for (const SnapshotInfo& r : kept)
     if (r.particles > 0) used.insert(r.particles);
   for (const std::string& member : file_->group_members(kXdmfGroup)) {
     const std::optional<std::uint64_t> n = polyvertex_size(member);
@@ -472,15 +587,22 @@ void SnapshotWriter::reconcile_polyvertex() {
   }
 }
 
+// Closes the file and syncs both files to disk: the file is opened once more (collectively)
+// and flushed (MPI_File_sync), and rank 0 syncs snapshots.xmf and the folder.
 void SnapshotWriter::close() {
-  if (!file_) return;
+  if (closed_) return;
+  closed_ = true;
   std::string error;
   try {
+    if (!file_) file_.emplace(h5::ParallelFile::open(comm_, h5_path_));
+    file_->flush();
     file_->close();
   } catch (const IoError& e) {
     error = e.what();
   }
   file_.reset();
+  mpi::agree_on_failure<IoError>(comm_, error);
+  if (rank_ == 0 && written_ > 0) error = xdmf_->sync();
   mpi::agree_on_failure<IoError>(comm_, error);
 }
 

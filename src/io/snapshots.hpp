@@ -13,11 +13,16 @@
 //       field's FieldMeta (`material` also `names`, "0=steel,1=ore"); then `speed` (|velocity|,
 //       m/s); then any extra fields. The group tracks the creation order of its datasets
 //       (resume() reads them back in that order). Only per-particle datasets: post/*.py and
-//       the tests read every member as N rows.
+//       the tests read every member as N rows. A field marked `stable` (id, material, radius)
+//       whose rows on every rank are those it stored last is not stored again: the member is a
+//       hard link to the stored dataset (one object, two names; readers see no difference).
 //   /walls/NNNNNN                        the wall outline at snapshot NNNNNN's time, when write()
 //                                        was given one: attributes time, step;
 //       points   (M x 2 double, m)       the outline's points in the lab frame
 //       segments (S x 2 int64)           the straight pieces, as pairs of rows of `points`
+//                                        each a hard link to the last stored one when equal to
+//                                        it (the segments of a scene: always; the points: while
+//                                        the walls stand still)
 //   /incomplete/NNNNNN, /incomplete/walls_NNNNNN
 //                                        the snapshot being written and its outline (staging);
 //                                        empty between writes, except after a failed write
@@ -25,12 +30,17 @@
 //                                        its Polyvertex topology (one per particle count N)
 // N is the global number of owned particles; rank 0's particles come first, then rank 1's...
 //
-// Complete or absent. write() builds the snapshot in /incomplete/NNNNNN and its outline in
-// /incomplete/walls_NNNNNN, flushes the file, then moves the outline's link to /walls/NNNNNN
-// and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and flushes again. A
-// write that fails part-way (disk full) leaves at most partial groups under /incomplete, never
-// under /snapshots: everything under /snapshots is a complete snapshot. Readers (post/*.py)
-// list /snapshots only.
+// Complete or absent. write() opens the file (MPI-IO, collectively), builds the snapshot in
+// /incomplete/NNNNNN and its outline in /incomplete/walls_NNNNNN, moves the outline's link to
+// /walls/NNNNNN and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and closes
+// the file, which writes out all of its metadata; only then does rank 0 list the snapshot in
+// snapshots.xmf. Between writes the file is closed and whole, so a run killed then leaves every
+// listed snapshot readable. A write that fails part-way (disk full) leaves at most partial
+// groups under /incomplete, never under /snapshots: everything under /snapshots is a complete
+// snapshot. Readers (post/*.py) list /snapshots only. Syncing to disk (fsync) is what a
+// snapshot would otherwise cost most: write() syncs both files (H5Fflush before the close, then
+// snapshots.xmf and the folder) only when kSyncInterval of wall time (rank 0's clock) has
+// passed since the last sync, and close() syncs them at the end.
 //
 // snapshots.xmf (XDMF 3): a temporal collection with, per snapshot, a spatial collection at its
 // time of two grids: "particles", a Polyvertex grid with XY geometry from position, every
@@ -50,8 +60,11 @@
 // message on every rank.
 #pragma once
 
+#include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -135,33 +148,43 @@ class SnapshotWriter {
   // Writes the owned particles [0, n_owned()) as the next snapshot, with the wall outline
   // `walls` (polylines in the lab frame at `time`, e.g. core/geometry/walls.hpp's wall_outlines;
   // rank 0's are written, every rank passes the same; none: no /walls group, no "walls" grid):
-  // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, flush, move to /walls/NNNNNN and
-  // /snapshots/NNNNNN, flush; then rank 0 appends its grid to snapshots.xmf. After a failed
-  // write (IoError) the writer may write again: the next write first removes what the failed
+  // /incomplete/NNNNNN and /incomplete/walls_NNNNNN, moved to /walls/NNNNNN and
+  // /snapshots/NNNNNN, the file closed; then rank 0 appends its grid to snapshots.xmf. After a
+  // failed write (IoError) the writer may write again: the next write first removes what the failed
   // one left and reuses its number if it did not reach /snapshots.
   void write(const ParticleStore& particles, double time, std::int64_t step,
              std::span<const std::vector<Vec2>> walls = {}, std::span<const ExtraField> extra = {});
 
-  // Closes the file and reports a failure (the destructor cannot). Later writes are errors.
+  // Syncs snapshots.h5, snapshots.xmf and the folder to disk and reports a failure (the
+  // destructor neither syncs nor reports). Later writes are errors.
   void close();
 
   const std::string& h5_path() const { return h5_path_; }
   const std::string& xdmf_path() const;
-  // The snapshots under /snapshots, in order: those written, after those a resume kept.
-  const std::vector<SnapshotInfo>& snapshots() const { return records_; }
-  std::size_t snapshots_written() const { return records_.size(); }
+  // The snapshots under /snapshots: those a resume kept and those written since.
+  std::size_t snapshots_written() const { return written_; }
+  // The last of them (std::nullopt while there is none). The writer keeps no other record of
+  // the snapshots before it: its memory does not grow with their number.
+  const std::optional<SnapshotInfo>& last_snapshot() const { return last_; }
 
   // Testing only (tests/io): the next write() throws IoError on every rank, as a full disk
   // would, just before it writes dataset number `datasets` (0: the first) of its staging
   // group (snapshot_datasets, then the extra fields), or, when the snapshot has no more
-  // datasets than that, after the last one and the wall outline (before the flush and the
-  // moves); the message ends in "injected failure". It costs a write nothing when not armed.
-  // Collective: call it on every rank.
+  // datasets than that, after the last one and the wall outline (before the moves); the message
+  // ends in "injected failure". It costs a write nothing when not armed. Collective: call it on
+  // every rank.
   void fail_before_dataset_for_testing(std::size_t datasets) { fail_before_dataset_ = datasets; }
 
  private:
   struct NoFile {};  // the constructors' common part: the paths, no file opened yet
   struct WallData;   // an outline as written: points and segments
+  // A dataset stored only when it changes (a stable field, the wall outline's points and
+  // segments): its published name and this rank's rows and bytes, as last stored.
+  struct Stored {
+    std::string path;
+    h5::RowRange rows;
+    std::vector<std::byte> bytes;
+  };
   static WallData wall_data(std::span<const std::vector<Vec2>> outlines);
   SnapshotWriter(NoFile, MPI_Comm comm, const std::string& directory);
   SnapshotInfo describe(const ParticleStore& p, double time, std::int64_t step,
@@ -170,15 +193,23 @@ class SnapshotWriter {
   void clear_failed_write(const std::string& name);
   void stage(const std::string& group, const SnapshotInfo& record, const h5::RowRange& rows,
              const ParticleStore& p, std::span<const ExtraField> extra, const WallData& walls);
-  void write_datasets(const std::string& group, const h5::RowRange& rows, const ParticleStore& p,
+  std::optional<std::vector<SnapshotInfo>> publish(const SnapshotInfo& record, bool sync);
+  bool link_if_unchanged(const std::string& key, const std::string& staged,
+                         const std::string& published, const h5::RowRange& rows, const void* data,
+                         std::size_t bytes);
+  std::vector<SnapshotInfo> published_records() const;
+  void read_walls(SnapshotInfo& record) const;
+  void sync_due(std::array<int, 3>& header);
+  void write_datasets(const std::string& group, const std::string& published,
+                      const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
   void write_polyvertex(const h5::RowRange& rows);
   void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
-  void agree(const std::string& local_error);  // IoError on every rank if any failed
-  void drop_and_read(double last_time);        // resume: the file's part
-  std::optional<SnapshotInfo> read_record(const std::string& name, double last_time);
-  void reconcile_polyvertex();
-  void reconcile_walls();
+  void agree(const std::string& local_error);                 // IoError on every rank if any failed
+  std::vector<SnapshotInfo> drop_and_read(double last_time);  // resume: the file's part
+  std::optional<SnapshotInfo> read_record(const std::string& name, double last_time) const;
+  void reconcile_polyvertex(const std::vector<SnapshotInfo>& kept);
+  void reconcile_walls(std::vector<SnapshotInfo>& kept);
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -186,7 +217,12 @@ class SnapshotWriter {
   std::unique_ptr<XdmfSidecar> xdmf_;  // snapshots.xmf, kept by rank 0 (xdmf.hpp)
   std::optional<h5::ParallelFile> file_;
   std::vector<std::string> material_names_;  // /materials/name: snapshots.xmf names them
-  std::vector<SnapshotInfo> records_;
+  std::optional<SnapshotInfo> last_;         // the last snapshot under /snapshots
+  std::size_t written_ = 0;                  // snapshots under /snapshots
+  std::map<std::string, Stored> stored_;     // by field name, or "walls/points", ...
+  std::map<std::string, Stored> pending_;    // this write's new ones: stored_ once published
+  std::chrono::steady_clock::time_point last_sync_ = std::chrono::steady_clock::now();
+  bool closed_ = false;                       // close() was called
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
   bool failed_ = false;                       // the last write failed: clear its remains first

@@ -212,16 +212,25 @@ std::string XdmfSidecar::rewrite(const std::vector<SnapshotInfo>& snapshots,
   return error;
 }
 
+bool XdmfSidecar::can_append() const {
+  std::error_code ec;
+  return trailer_.has_value() && fs::is_regular_file(path_, ec);
+}
+
 // O(1): the new grid and the trailer over the old trailer. On a failure the old trailer is put
 // back and the file cut after it (best effort), and the next snapshot rewrites the file whole.
-std::string XdmfSidecar::append(const std::vector<SnapshotInfo>& snapshots,
+std::string XdmfSidecar::append(const SnapshotInfo& snapshot,
                                 const std::vector<std::string>& material_names) {
-  if (!trailer_) return rewrite(snapshots, material_names);  // the first, or after a failure
   const int fd = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0) return rewrite(snapshots, material_names);  // removed meanwhile: made anew
+  if (fd < 0 || !trailer_) {
+    const int error = errno;
+    if (fd >= 0) ::close(fd);
+    trailer_.reset();
+    return fmt::format("cannot open {}: {}", path_, std::strerror(error));
+  }
   const auto at = static_cast<off_t>(*trailer_);
   trailer_.reset();  // until the write succeeded
-  const std::string grid = xdmf_grid(h5_name_, snapshots.back(), material_names);
+  const std::string grid = xdmf_grid(h5_name_, snapshot, material_names);
   bool ok = write_at(fd, grid + std::string(kXdmfTrailer), at);
   int error = errno;
   if (!ok && write_at(fd, kXdmfTrailer, at))
@@ -233,6 +242,29 @@ std::string XdmfSidecar::append(const std::vector<SnapshotInfo>& snapshots,
   if (!ok) return fmt::format("cannot write {}: {}", path_, std::strerror(error));
   trailer_ = static_cast<long>(at) + static_cast<long>(grid.size());
   return {};
+}
+
+namespace {
+
+// fsync of the file or folder `path`; an error message, empty on success.
+std::string sync_path(const std::string& path, int flags) {
+  const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+  if (fd < 0) return fmt::format("cannot open {}: {}", path, std::strerror(errno));
+  const bool ok = ::fsync(fd) == 0;
+  const int error = errno;
+  ::close(fd);
+  return ok ? std::string() : fmt::format("cannot sync {}: {}", path, std::strerror(error));
+}
+
+}  // namespace
+
+std::string XdmfSidecar::sync() const {
+  std::error_code ec;
+  if (!fs::exists(path_, ec)) return {};
+  std::string error = sync_path(path_, O_RDONLY);
+  if (!error.empty()) return error;
+  const fs::path folder = fs::path(path_).parent_path();
+  return sync_path(folder.empty() ? "." : folder.string(), O_RDONLY | O_DIRECTORY);
 }
 
 }  // namespace dem2d

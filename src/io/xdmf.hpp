@@ -30,11 +30,14 @@ class XdmfSidecar {
   // are none.
   std::string rewrite(const std::vector<SnapshotInfo>& snapshots,
                       const std::vector<std::string>& material_names);
-  // Adds the last of `snapshots` in place, O(1); writes the whole file instead for the first
-  // snapshot, after a failed write, or when the file has gone. On a failure the old trailer is
+  // Whether append() can add a snapshot: the file is there as this sidecar last wrote it. Not
+  // for the first snapshot, after a failed write, or when the file has gone: rewrite() then.
+  bool can_append() const;
+  // Adds `snapshot` in place, O(1) (can_append() must hold). On a failure the old trailer is
   // put back and the file cut after it (best effort).
-  std::string append(const std::vector<SnapshotInfo>& snapshots,
-                     const std::vector<std::string>& material_names);
+  std::string append(const SnapshotInfo& snapshot, const std::vector<std::string>& material_names);
+  // Syncs the file and its folder to disk (fsync), so that they survive a crash of the machine.
+  std::string sync() const;
 
  private:
   std::string path_;

@@ -33,6 +33,9 @@ struct FieldMeta {
   std::string unit{};     // SI unit as written in snapshots ("m/s"); "1" for a pure number
   std::string doc{};      // one line
   bool snapshot = false;  // written to snapshots.h5 (state a user reads back)
+  // Set when a particle is added and seldom changed after (id, material, radius): snapshots.h5
+  // stores it again only when its rows differ from the last stored ones (io/snapshots.hpp).
+  bool stable = false;
 };
 
 class FieldBase {
@@ -116,8 +119,8 @@ class ParticleStore {
 
   // Identity and material.
   Field<std::int64_t> id{
-      "id", registry_, {"1", "particle id, unique and stable for the whole run", true}};
-  Field<std::int32_t> material{"material", registry_, {"1", "row of /materials", true}};
+      "id", registry_, {"1", "particle id, unique and stable for the whole run", true, true}};
+  Field<std::int32_t> material{"material", registry_, {"1", "row of /materials", true, true}};
   // Kinematics: position, velocity, acceleration (translational), angle, spin, angular acc.
   Field<Vec2> pos{"position", registry_, {"m", "x and y of the centre", true}};
   Field<Vec2> vel{"velocity", registry_, {"m/s", "x and y of the centre's velocity", true}};
@@ -128,7 +131,7 @@ class ParticleStore {
       "spin", registry_, {"rad/s", "angular velocity, counter-clockwise positive", true}};
   Field<double> alpha{"angular_acceleration", registry_, {"rad/s^2", "angular acceleration"}};
   // Shape and inertia (derived from radius and material density when a particle is added).
-  Field<double> radius{"radius", registry_, {"m", "radius", true}};
+  Field<double> radius{"radius", registry_, {"m", "radius", true, true}};
   Field<double> mass{"mass", registry_, {"kg", "mass, 4/3 pi r^3 rho"}};
   Field<double> inv_mass{"inv_mass", registry_, {"1/kg", "1 / mass"}};
   Field<double> inv_inertia{"inv_inertia", registry_, {"1/(kg m^2)", "1 / (2/5 m r^2)"}};
