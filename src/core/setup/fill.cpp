@@ -11,6 +11,7 @@
 #include "core/base/errors.hpp"
 #include "core/base/random.hpp"
 #include "core/geometry/drum_geometry.hpp"
+#include "core/setup/size_law.hpp"
 #include "core/setup/validate.hpp"
 #include "core/shape/disc.hpp"
 
@@ -18,29 +19,24 @@ namespace dem2d {
 
 namespace {
 
-constexpr std::uint64_t kFillStream = 0xF111ULL << 32;
-
-double fill_radius(const Scene& scene, std::size_t f, std::int64_t k) {
-  const FillSpec& s = scene.fills[f];
-  if (s.radius_max <= s.radius_min) return s.radius_min;
-  const double u = random_uniform(scene.run.seed, kFillStream + f, static_cast<std::uint64_t>(k));
-  return s.radius_min + u * (s.radius_max - s.radius_min);
-}
-
 // "deck.in:14:9: error: fill[0].count = 5000: ", at the key that sets how many the fill places
 // (Scene::where), else at the fill's line.
 std::string where(const Scene& scene, const FillSpec& s) {
   const std::string fill = "fill[" + std::to_string(s.index) + "]";
-  const std::string key = fill + (s.count > 0 ? ".count" : ".fill_fraction");
+  std::ostringstream value;
+  std::string key = fill + ".count";
+  if (s.count > 0) {
+    value << s.count;
+  } else if (s.bed_filling > 0.0) {
+    key = fill + ".bed_filling";
+    value << s.bed_filling;
+  } else {
+    key = fill + ".fill_fraction";
+    value << s.fill_fraction;
+  }
   const auto it = scene.where.find(key);
   if (it == scene.where.end())
     return scene.deck_path + ":" + std::to_string(s.source_line) + ": error: " + fill + ": ";
-  std::ostringstream value;
-  if (s.count > 0) {
-    value << s.count;
-  } else {
-    value << s.fill_fraction;
-  }
   return it->second + ": error: " + key + " = " + value.str() + ": ";
 }
 
@@ -86,16 +82,8 @@ class PlacedGrid {
 
 std::int64_t fill_count(const Scene& scene, std::size_t f) {
   const FillSpec& s = scene.fills[f];
-  if (s.count > 0) return s.count;
-  const double target = s.fill_fraction * std::numbers::pi * scene.drum.radius * scene.drum.radius;
-  double area = 0.0;
-  std::int64_t k = 0;
-  while (area < target) {
-    const double r = fill_radius(scene, f, k);
-    area += std::numbers::pi * r * r;
-    ++k;
-  }
-  return k;
+  if (s.count > 0) return s.count;  // a table apportions exactly its count
+  return static_cast<std::int64_t>(fill_radii(scene, f).size());
 }
 
 namespace {
@@ -106,15 +94,16 @@ struct Site {
   double key;
 };
 
-// The sites of fill f: a triangular lattice of spacing 2.1 radius_max over the region, minus
-// the sites that touch a wall or a particle already placed, each with its key (random for
-// `full` and `box`, by row for `bottom`, by distance from the shell for `annulus`).
+// The sites of fill f (and the fills mixed with it): a triangular lattice of spacing 2.1
+// radius_max (the group's largest) over the region, minus the sites that touch a wall or a
+// particle already placed, each with its key (random for `full` and `box`, by row for
+// `bottom`, by distance from the shell for `annulus`).
 std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const ParticleStore& store,
-                             std::size_t f, double r_all_max) {
+                             std::size_t f, double radius_max, double r_all_max) {
   const FillSpec& s = scene.fills[f];
   const bool needs_drum = s.region != FillRegion::kBox;
   const DrumGeometry drum(scene.drum);
-  const double spacing = 2.1 * s.radius_max;
+  const double spacing = 2.1 * radius_max;
   const double row = spacing * std::sqrt(3.0) / 2.0;
   Vec2 lo = s.box_min, hi = s.box_max;
   const Vec2 c = scene.drum.center;
@@ -149,6 +138,88 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
   return sites;
 }
 
+// Fills [first, last) placed together: one fill, or one and the fills after it that mix with it
+// (mix = true), on one lattice of spacing 2.1 radius_max, the group's largest.
+struct Group {
+  std::size_t first = 0, last = 0;
+  double radius_max = 0.0;
+};
+
+std::string group_names(const Group& g, const Scene& scene) {
+  std::string names;
+  for (std::size_t f = g.first; f < g.last; ++f)
+    names += (f == g.first      ? ""
+              : f + 1 == g.last ? " and "
+                                : ", ") +
+             std::string("fill[") + std::to_string(scene.fills[f].index) + "]";
+  return names;
+}
+
+// The site (index into the sorted sites) of each particle of the group, in id order: the
+// identity for one fill; for mixed fills a permutation by (seed, first fill), so that each
+// fill's particles are spread over the group's sites in proportion to their numbers.
+std::vector<std::size_t> group_sites(const Scene& scene, const Group& g, std::size_t n) {
+  std::vector<std::size_t> site(n);
+  for (std::size_t k = 0; k < n; ++k) site[k] = k;
+  if (g.last - g.first < 2) return site;
+  for (std::size_t i = n; i > 1; --i) {  // Fisher-Yates
+    const double u = random_uniform(scene.run.seed, kFillStream + 4000 + g.first, i - 1);
+    std::swap(site[i - 1],
+              site[std::min(static_cast<std::size_t>(u * static_cast<double>(i)), i - 1)]);
+  }
+  return site;
+}
+
+// Places the particles of one group at its lattice's first sites, each jittered within its
+// site's slack; an error when the region cannot hold them (placing nothing).
+void place_group(const Scene& scene, const Walls& walls, ParticleStore& store, const Group& g,
+                 double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const FillSpec& head = scene.fills[g.first];
+  if (head.region != FillRegion::kBox && !scene.drum.present) {
+    errors.push_back(where(scene, head) +
+                     "region needs a [drum]; use region = \"box\" with box_min and box_max");
+    return;
+  }
+  std::vector<std::vector<double>> radii;
+  std::size_t n = 0;
+  for (std::size_t f = g.first; f < g.last; ++f) {
+    radii.push_back(fill_radii(scene, f));
+    n += radii.back().size();
+  }
+  std::vector<Site> sites = fill_sites(scene, walls, store, g.first, g.radius_max, r_all_max);
+  if (sites.size() < n) {
+    std::ostringstream o;
+    o << n << " particles do not fit: the region holds " << sites.size()
+      << " clear of the walls and the particles placed before, at radius_max " << g.radius_max
+      << " m";
+    if (g.last - g.first > 1) o << " (" << group_names(g, scene) << " mixed)";
+    o << "; lower count, fill_fraction or bed_filling, or enlarge the region";
+    errors.push_back(where(scene, head) + o.str());
+    return;
+  }
+  std::stable_sort(sites.begin(), sites.end(),
+                   [](const Site& a, const Site& b) { return a.key < b.key; });
+  const std::vector<std::size_t> site = group_sites(scene, g, n);
+  const double spacing = 2.1 * g.radius_max;  // as in fill_sites
+  const double half = 0.5 * spacing;
+  std::size_t first = 0;  // the fill's first particle in the group
+  for (std::size_t f = g.first; f < g.last; ++f) {
+    const FillSpec& s = scene.fills[f];
+    const int mat = find_material(scene, s.material);
+    const std::vector<double>& r = radii[f - g.first];
+    for (std::size_t k = 0; k < r.size(); ++k) {
+      // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
+      const double slack = half - r[k];
+      const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
+      const double jy =
+          random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
+      const Vec2 x = sites[site[first + k]].x + (slack * 0.7071) * Vec2{jx, jy};
+      store.add(next_id++, mat, r[k], scene.materials[mat].density, x, s.velocity, 0.0);
+    }
+    first += r.size();
+  }
+}
+
 }  // namespace
 
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store) {
@@ -165,38 +236,12 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   for (const FillSpec& s : scene.fills) r_all_max = std::max(r_all_max, s.radius_max);
   if (r_all_max <= 0.0) return;
 
-  for (std::size_t f = 0; f < scene.fills.size(); ++f) {
-    const FillSpec& s = scene.fills[f];
-    if (s.region != FillRegion::kBox && !scene.drum.present) {
-      errors.push_back(where(scene, s) +
-                       "region needs a [drum]; use region = \"box\" with box_min and box_max");
-      continue;
-    }
-    const std::int64_t n = fill_count(scene, f);
-    std::vector<Site> sites = fill_sites(scene, walls, store, f, r_all_max);
-    if (static_cast<std::int64_t>(sites.size()) < n) {
-      std::ostringstream o;
-      o << n << " particles do not fit: the region holds " << sites.size()
-        << " clear of the walls and the particles placed before, at radius_max " << s.radius_max
-        << " m; lower count or fill_fraction, or enlarge the region";
-      errors.push_back(where(scene, s) + o.str());
-      continue;
-    }
-    std::stable_sort(sites.begin(), sites.end(),
-                     [](const Site& a, const Site& b) { return a.key < b.key; });
-    const int mat = find_material(scene, s.material);
-    const double spacing = 2.1 * s.radius_max;  // as in fill_sites
-    const double half = 0.5 * spacing;
-    for (std::int64_t k = 0; k < n; ++k) {
-      const double r = fill_radius(scene, f, k);
-      // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
-      const double slack = half - r;
-      const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
-      const double jy =
-          random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
-      const Vec2 x = sites[k].x + (slack * 0.7071) * Vec2{jx, jy};
-      store.add(next_id++, mat, r, scene.materials[mat].density, x, s.velocity, 0.0);
-    }
+  for (std::size_t f = 0; f < scene.fills.size();) {
+    Group g{f, f + 1, scene.fills[f].radius_max};
+    while (g.last < scene.fills.size() && scene.fills[g.last].mix)
+      g.radius_max = std::max(g.radius_max, scene.fills[g.last++].radius_max);
+    place_group(scene, walls, store, g, r_all_max, next_id, errors);
+    f = g.last;
   }
   if (!errors.empty()) throw InputError(errors);
 }
