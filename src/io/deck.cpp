@@ -620,8 +620,7 @@ class DeckParser {
     double sum = 0.0;
     for (const double w : *fractions) sum += w;
     if (std::abs(sum - 1.0) > 1e-9) {
-      r.invalid("mass_fractions",
-                fmt::format("sum to {}; must sum to 1 (within 1e-9)", toml_number(sum)));
+      r.invalid("mass_fractions", fmt::format("sum to {:.12g}; must sum to 1 (within 1e-9)", sum));
     }
   }
 

@@ -128,8 +128,7 @@ EOF
 cat > "$tmp/sizes.in" <<'EOF'
 title = "sizes"
 [run]
-duration = 0.004
-dt = 2.0e-5
+duration = 0.0004
 [[material]]
 name = "steel"
 density = 7800.0
@@ -166,7 +165,7 @@ size_distribution = "table"
 sizes = [0.01, 0.02]
 mass_fractions = [0.4, 0.6]
 [output]
-snapshot_interval = 0.002
+snapshot_interval = 0.0002
 EOF
 "$dem2d" --quiet "$tmp/sizes.in" --output "$tmp/sz1" > "$tmp/sz1.log" 2>&1 || fail "sizes np1: $(cat "$tmp/sz1.log")"
 mpirun -np 3 --oversubscribe "$dem2d" --quiet "$tmp/sizes.in" --output "$tmp/sz3" > "$tmp/sz3.log" 2>&1 ||

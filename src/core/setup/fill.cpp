@@ -40,13 +40,13 @@ std::string where(const Scene& scene, const FillSpec& s) {
   return it->second + ": error: " + key + " = " + value.str() + ": ";
 }
 
-// Uniform grid of placed particles for overlap checks.
+// Uniform grid of placed particles (their centres and radii) for overlap checks.
 class PlacedGrid {
  public:
-  PlacedGrid(const ParticleStore& p, double cell) : p_(p), h_(cell) {
-    for (std::size_t k = 0; k < p.size(); ++k) insert(k);
+  PlacedGrid(const ParticleStore& p, double cell) : h_(cell) {
+    for (std::size_t k = 0; k < p.size(); ++k) insert(p.pos[k], p.radius[k]);
   }
-  void insert(std::size_t k) { cells_[key(p_.pos[k])].push_back(k); }
+  void insert(Vec2 x, double r) { cells_[key(x)].push_back({x, r}); }
   bool overlaps(Vec2 x, double r, double r_max) const {
     const auto [cx, cy] = index(x);
     const int reach = static_cast<int>(std::ceil((r + r_max) / h_));
@@ -54,9 +54,9 @@ class PlacedGrid {
       for (int dx = -reach; dx <= reach; ++dx) {
         auto it = cells_.find(pack(cx + dx, cy + dy));
         if (it == cells_.end()) continue;
-        for (std::size_t k : it->second) {
-          const double s = r + p_.radius[k];
-          if (norm2(p_.pos[k] - x) < s * s) return true;
+        for (const Disc& d : it->second) {
+          const double s = r + d.r;
+          if (norm2(d.x - x) < s * s) return true;
         }
       }
     return false;
@@ -73,9 +73,12 @@ class PlacedGrid {
     const auto [a, b] = index(x);
     return pack(a, b);
   }
-  const ParticleStore& p_;
+  struct Disc {
+    Vec2 x;
+    double r;
+  };
   double h_;
-  std::unordered_map<long long, std::vector<std::size_t>> cells_;
+  std::unordered_map<long long, std::vector<Disc>> cells_;
 };
 
 }  // namespace
@@ -94,10 +97,9 @@ struct Site {
   double key;
 };
 
-// The sites of fill f (and the fills mixed with it): a triangular lattice of spacing 2.1
-// radius_max (the group's largest) over the region, minus the sites that touch a wall or a
-// particle already placed, each with its key (random for `full` and `box`, by row for
-// `bottom`, by distance from the shell for `annulus`).
+// The sites of fill f: a triangular lattice of spacing 2.1 radius_max over the region, minus
+// the sites that touch a wall or a particle already placed, each with its key (random for
+// `full` and `box`, by row for `bottom`, by distance from the shell for `annulus`).
 std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const ParticleStore& store,
                              std::size_t f, double radius_max, double r_all_max) {
   const FillSpec& s = scene.fills[f];
@@ -139,10 +141,9 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
 }
 
 // Fills [first, last) placed together: one fill, or one and the fills after it that mix with it
-// (mix = true), on one lattice of spacing 2.1 radius_max, the group's largest.
+// (mix = true).
 struct Group {
   std::size_t first = 0, last = 0;
-  double radius_max = 0.0;
 };
 
 std::string group_names(const Group& g, const Scene& scene) {
@@ -155,23 +156,96 @@ std::string group_names(const Group& g, const Scene& scene) {
   return names;
 }
 
-// The site (index into the sorted sites) of each particle of the group, in id order: the
-// identity for one fill; for mixed fills a permutation by (seed, first fill), so that each
-// fill's particles are spread over the group's sites in proportion to their numbers.
-std::vector<std::size_t> group_sites(const Scene& scene, const Group& g, std::size_t n) {
-  std::vector<std::size_t> site(n);
-  for (std::size_t k = 0; k < n; ++k) site[k] = k;
-  if (g.last - g.first < 2) return site;
-  for (std::size_t i = n; i > 1; --i) {  // Fisher-Yates
-    const double u = random_uniform(scene.run.seed, kFillStream + 4000 + g.first, i - 1);
-    std::swap(site[i - 1],
-              site[std::min(static_cast<std::size_t>(u * static_cast<double>(i)), i - 1)]);
-  }
-  return site;
+// Jitter of particle k of fill f within its site's slack, half - r: the site's circle of radius
+// half (half the spacing) holds the sphere.
+Vec2 jitter(const Scene& scene, std::size_t f, std::size_t k, double slack) {
+  const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
+  const double jy = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
+  return (slack * 0.7071) * Vec2{jx, jy};
 }
 
-// Places the particles of one group at its lattice's first sites, each jittered within its
-// site's slack; an error when the region cannot hold them (placing nothing).
+std::string do_not_fit(const Scene& scene, std::size_t f, std::size_t n, std::size_t sites,
+                       const std::string& mixed) {
+  std::ostringstream o;
+  o << n << " particles do not fit: the region holds " << sites
+    << " clear of the walls and the particles placed before, at radius_max "
+    << scene.fills[f].radius_max << " m" << mixed
+    << "; lower count, fill_fraction or bed_filling, or enlarge the region";
+  return where(scene, scene.fills[f]) + o.str();
+}
+
+// One fill alone: its particles at the first sites of its lattice, in id order.
+void place_fill(const Scene& scene, const Walls& walls, ParticleStore& store, std::size_t f,
+                double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const FillSpec& s = scene.fills[f];
+  const std::vector<double> r = fill_radii(scene, f);
+  std::vector<Site> sites = fill_sites(scene, walls, store, f, s.radius_max, r_all_max);
+  if (sites.size() < r.size()) {
+    errors.push_back(do_not_fit(scene, f, r.size(), sites.size(), ""));
+    return;
+  }
+  std::stable_sort(sites.begin(), sites.end(),
+                   [](const Site& a, const Site& b) { return a.key < b.key; });
+  const int mat = find_material(scene, s.material);
+  const double spacing = 2.1 * s.radius_max;  // as in fill_sites
+  const double half = 0.5 * spacing;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    const Vec2 x = sites[k].x + jitter(scene, f, k, half - r[k]);
+    store.add(next_id++, mat, r[k], scene.materials[mat].density, x, s.velocity, 0.0);
+  }
+}
+
+// Mixed fills: each keeps its own lattice, sorted as its region says; the group's particles
+// are dealt in an order shuffled by (seed, first fill), each fill's in proportion to their
+// numbers, and each takes the next site of its own lattice (the lowest free one for "bottom")
+// that is clear of the particles the group placed before it. Ids follow the deck's order.
+void place_mixed(const Scene& scene, const Walls& walls, ParticleStore& store, const Group& g,
+                 double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const std::size_t m = g.last - g.first;
+  std::vector<std::vector<double>> radii(m);
+  std::vector<std::vector<Site>> sites(m);
+  std::vector<std::vector<Vec2>> at(m);
+  std::vector<std::size_t> owner;  // the fill (0 .. m-1) of each particle dealt
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t f = g.first + i;
+    radii[i] = fill_radii(scene, f);
+    sites[i] = fill_sites(scene, walls, store, f, scene.fills[f].radius_max, r_all_max);
+    std::stable_sort(sites[i].begin(), sites[i].end(),
+                     [](const Site& a, const Site& b) { return a.key < b.key; });
+    owner.insert(owner.end(), radii[i].size(), i);
+  }
+  for (std::size_t j = owner.size(); j > 1; --j) {  // Fisher-Yates
+    const double u = random_uniform(scene.run.seed, kFillStream + 4000 + g.first, j - 1);
+    std::swap(owner[j - 1],
+              owner[std::min(static_cast<std::size_t>(u * static_cast<double>(j)), j - 1)]);
+  }
+  PlacedGrid placed(store, 2.0 * r_all_max);
+  std::vector<std::size_t> next(m, 0);
+  for (const std::size_t i : owner) {
+    const std::size_t f = g.first + i, k = at[i].size();
+    const double r = radii[i][k];
+    const Vec2 offset = jitter(scene, f, k, 0.5 * (2.1 * scene.fills[f].radius_max) - r);
+    while (next[i] < sites[i].size() && placed.overlaps(sites[i][next[i]].x + offset, r, r_all_max))
+      ++next[i];
+    if (next[i] == sites[i].size()) {
+      errors.push_back(
+          do_not_fit(scene, f, radii[i].size(), k,
+                     " beside the fills it mixes with (" + group_names(g, scene) + ")"));
+      return;
+    }
+    at[i].push_back(sites[i][next[i]++].x + offset);
+    placed.insert(at[i].back(), r);
+  }
+  for (std::size_t i = 0; i < m; ++i) {
+    const FillSpec& s = scene.fills[g.first + i];
+    const int mat = find_material(scene, s.material);
+    for (std::size_t k = 0; k < at[i].size(); ++k)
+      store.add(next_id++, mat, radii[i][k], scene.materials[mat].density, at[i][k], s.velocity,
+                0.0);
+  }
+}
+
+// One group: one fill placed alone, or mixed fills placed together.
 void place_group(const Scene& scene, const Walls& walls, ParticleStore& store, const Group& g,
                  double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
   const FillSpec& head = scene.fills[g.first];
@@ -180,43 +254,10 @@ void place_group(const Scene& scene, const Walls& walls, ParticleStore& store, c
                      "region needs a [drum]; use region = \"box\" with box_min and box_max");
     return;
   }
-  std::vector<std::vector<double>> radii;
-  std::size_t n = 0;
-  for (std::size_t f = g.first; f < g.last; ++f) {
-    radii.push_back(fill_radii(scene, f));
-    n += radii.back().size();
-  }
-  std::vector<Site> sites = fill_sites(scene, walls, store, g.first, g.radius_max, r_all_max);
-  if (sites.size() < n) {
-    std::ostringstream o;
-    o << n << " particles do not fit: the region holds " << sites.size()
-      << " clear of the walls and the particles placed before, at radius_max " << g.radius_max
-      << " m";
-    if (g.last - g.first > 1) o << " (" << group_names(g, scene) << " mixed)";
-    o << "; lower count, fill_fraction or bed_filling, or enlarge the region";
-    errors.push_back(where(scene, head) + o.str());
-    return;
-  }
-  std::stable_sort(sites.begin(), sites.end(),
-                   [](const Site& a, const Site& b) { return a.key < b.key; });
-  const std::vector<std::size_t> site = group_sites(scene, g, n);
-  const double spacing = 2.1 * g.radius_max;  // as in fill_sites
-  const double half = 0.5 * spacing;
-  std::size_t first = 0;  // the fill's first particle in the group
-  for (std::size_t f = g.first; f < g.last; ++f) {
-    const FillSpec& s = scene.fills[f];
-    const int mat = find_material(scene, s.material);
-    const std::vector<double>& r = radii[f - g.first];
-    for (std::size_t k = 0; k < r.size(); ++k) {
-      // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
-      const double slack = half - r[k];
-      const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
-      const double jy =
-          random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
-      const Vec2 x = sites[site[first + k]].x + (slack * 0.7071) * Vec2{jx, jy};
-      store.add(next_id++, mat, r[k], scene.materials[mat].density, x, s.velocity, 0.0);
-    }
-    first += r.size();
+  if (g.last - g.first == 1) {
+    place_fill(scene, walls, store, g.first, r_all_max, next_id, errors);
+  } else {
+    place_mixed(scene, walls, store, g, r_all_max, next_id, errors);
   }
 }
 
@@ -237,9 +278,8 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   if (r_all_max <= 0.0) return;
 
   for (std::size_t f = 0; f < scene.fills.size();) {
-    Group g{f, f + 1, scene.fills[f].radius_max};
-    while (g.last < scene.fills.size() && scene.fills[g.last].mix)
-      g.radius_max = std::max(g.radius_max, scene.fills[g.last++].radius_max);
+    Group g{f, f + 1};
+    while (g.last < scene.fills.size() && scene.fills[g.last].mix) ++g.last;
     place_group(scene, walls, store, g, r_all_max, next_id, errors);
     f = g.last;
   }
