@@ -20,13 +20,26 @@ namespace {
 // (docs/input.md, "What --check tells").
 constexpr double kSettledCostFactor = 1.4;
 
+// "; asked: fill[0].bed_filling = 0.3": the fills that gave `key` (fill_fraction,
+// bed_filling) and their values, or "" when none did.
+std::string asked(const Scene& s, const char* key, double FillSpec::*value) {
+  std::string out;
+  for (const FillSpec& f : s.fills) {
+    if (!(f.*value > 0.0)) continue;
+    out += (out.empty() ? "; asked: " : ", ") + std::string("fill[") + std::to_string(f.index) +
+           "]." + key + fmt_double(" = %g", f.*value);
+  }
+  return out;
+}
+
 // The mill's numbers.
 std::string mill_check_lines(const Scene& s, const MillNumbers& m) {
-  std::string out =
-      fmt_double("  fill fraction:         %.4f (particle cross-sections / drum area)\n",
-                 m.fill_fraction) +
-      fmt_double("  bed filling J:         %.3f", m.bed_filling) +
-      fmt_double(" (the bed with its voids / drum area, packing %.2f)\n", kBedPacking);
+  std::string out = fmt_double("  fill fraction:         %.4f (particle cross-sections / drum area",
+                               m.fill_fraction) +
+                    asked(s, "fill_fraction", &FillSpec::fill_fraction) + ")\n" +
+                    fmt_double("  bed filling J:         %.3f", m.bed_filling) +
+                    fmt_double(" (the bed with its voids / drum area, packing %.2f", kBedPacking) +
+                    asked(s, "bed_filling", &FillSpec::bed_filling) + ")\n";
   out += fmt_double("  critical speed:        %.4f rad/s", m.critical_speed) +
          fmt_double(" = sqrt(g/R) (%.2f rpm);", m.critical_speed * 30.0 / std::numbers::pi) +
          fmt_double(" with fill (thesis T37) %.4f rad/s\n", m.critical_speed_with_fill);

@@ -200,6 +200,8 @@ class DeckParser {
         return r.number_or_auto(key.name, key.range, key.unit);
       case Type::kMaterialPair:
         return as_value(material_pair(r, key.name, key.need));
+      case Type::kNumberList:
+        return as_value(r.numbers(key.name, key.range, key.need));
       case Type::kTable:
       case Type::kTableArray:
         break;  // read by the caller, as its own table
@@ -469,31 +471,89 @@ class DeckParser {
     fill.index = static_cast<int>(index);
     const Accepted accepted = read_keys(r, deck::kFill, fill);
     std::vector<std::string_view> sources;
-    for (const std::string_view key : {"count", "fill_fraction", "file"}) {
+    for (const std::string_view key : {"count", "fill_fraction", "bed_filling", "file"}) {
       if (r.has(key)) sources.push_back(key);
     }
     if (sources.size() != 1) {
-      r.error(sources.empty()
-                  ? fmt::format("{} needs one of count, fill_fraction and file", r.path())
-                  : fmt::format("{}: give only one of count, fill_fraction and file (found {})",
-                                r.path(), and_list(sources)));
+      r.error(
+          sources.empty()
+              ? fmt::format("{} needs one of count, fill_fraction, bed_filling and file", r.path())
+              : fmt::format("{}: give only one of count, fill_fraction, bed_filling and "
+                            "file (found {})",
+                            r.path(), and_list(sources)));
     }
     if (sources.size() == 1 && sources[0] == "file") {
       for (const std::string_view key :
-           {"radius", "radius_min", "radius_max", "region", "box_min", "box_max"}) {
+           {"radius", "radius_min", "radius_max", "size_distribution", "d50", "sigma",
+            "geometric_sd", "sizes", "mass_fractions", "region", "box_min", "box_max", "mix"}) {
         if (r.has(key))
           r.invalid(key, "not used by a fill from a file (the file gives each particle)");
       }
       if (const auto file = accepted.get<std::string>("file")) read_fill_file(r, *file, fill);
+      previous_fill_ = FillSpec{};
+      previous_fill_->file = "(file)";
       return;
     }
     require(r, deck::kFill, "material");  // a file may name each row's material instead
-    if (accepted.has("fill_fraction") && !scene_.drum.present) {
-      r.invalid("fill_fraction", "needs a [drum] (it is a fraction of the drum's area)");
+    for (const std::string_view key : {"fill_fraction", "bed_filling"}) {
+      if (accepted.has(key) && !scene_.drum.present)
+        r.invalid(key, "needs a [drum] (it is a fraction of the drum's area)");
     }
-    read_fill_radii(r, accepted);
+    read_fill_sizes(r, accepted, fill);
     read_fill_region(r, accepted, fill);
+    read_fill_mix(r, fill);
+    previous_fill_ = fill;
     scene_.fills.push_back(std::move(fill));
+  }
+
+  // The size keys each law takes; any other is an error naming the law.
+  static void reject_other_size_keys(const TableReader& r, const FillSpec& fill) {
+    static constexpr std::string_view kKeys[] = {"radius", "radius_min",    "radius_max",
+                                                 "d50",    "sigma",         "geometric_sd",
+                                                 "sizes",  "mass_fractions"};
+    std::vector<std::string_view> takes;
+    switch (fill.size_distribution) {
+      case SizeDistribution::kUniform:
+        takes = {"radius", "radius_min", "radius_max"};
+        break;
+      case SizeDistribution::kNormal:
+        takes = {"d50", "sigma", "radius_min", "radius_max"};
+        break;
+      case SizeDistribution::kLognormal:
+        takes = {"d50", "geometric_sd", "radius_min", "radius_max"};
+        break;
+      case SizeDistribution::kTable:
+        takes = {"sizes", "mass_fractions"};
+        break;
+    }
+    const std::string law(deck::choice_name(deck::kSizeDistributions, fill.size_distribution));
+    const std::string which = fill.size_distribution == SizeDistribution::kUniform
+                                  ? "radius, or radius_min and radius_max"
+                                  : and_list(takes);
+    for (const std::string_view key : kKeys) {
+      if (r.has(key) && std::find(takes.begin(), takes.end(), key) == takes.end())
+        r.invalid(key, fmt::format("not used by size_distribution = \"{}\"{}, which takes {}", law,
+                                   r.has("size_distribution") ? "" : " (the default)", which));
+    }
+  }
+
+  // The fill's sizes by its law: radius or a radius range, a normal or lognormal law within
+  // a radius range, or a table of sizes and mass fractions.
+  static void read_fill_sizes(const TableReader& r, const Accepted& accepted, FillSpec& fill) {
+    if (r.has("size_distribution") && !accepted.has("size_distribution")) return;  // reported
+    reject_other_size_keys(r, fill);
+    switch (fill.size_distribution) {
+      case SizeDistribution::kUniform:
+        read_fill_radii(r, accepted);
+        return;
+      case SizeDistribution::kNormal:
+      case SizeDistribution::kLognormal:
+        read_fill_law(r, accepted, fill);
+        return;
+      case SizeDistribution::kTable:
+        read_fill_table(r, accepted, fill);
+        return;
+    }
   }
 
   // radius (mono-disperse) or radius_min and radius_max (uniform in r between them).
@@ -511,6 +571,74 @@ class DeckParser {
       }
     } else if (!r.has("radius")) {
       r.error(fmt::format("{} needs radius, or radius_min and radius_max (m, > 0)", r.path()));
+    }
+  }
+
+  // "normal" and "lognormal": d50 and the spread, truncated to [2 radius_min, 2 radius_max].
+  static void read_fill_law(const TableReader& r, const Accepted& accepted, const FillSpec& fill) {
+    const bool normal = fill.size_distribution == SizeDistribution::kNormal;
+    for (const std::string_view key :
+         {std::string_view("d50"), normal ? std::string_view("sigma") : "geometric_sd",
+          std::string_view("radius_min"), std::string_view("radius_max")})
+      require(r, deck::kFill, key);
+    const auto lo = accepted.get<double>("radius_min");
+    const auto hi = accepted.get<double>("radius_max");
+    if (!lo || !hi) return;
+    if (*lo >= *hi) {
+      r.invalid("radius_min",
+                fmt::format("must be < radius_max = {} (the truncation of the {} law)",
+                            r.shown("radius_max"), normal ? "normal" : "lognormal"));
+      return;
+    }
+    const auto d50 = accepted.get<double>("d50");
+    if (d50 && (*d50 < 2.0 * *lo || *d50 > 2.0 * *hi)) {
+      r.invalid("d50", fmt::format("must lie within [2 radius_min, 2 radius_max] = [{:g}, {:g}] "
+                                   "m (a diameter, within the truncation)",
+                                   2.0 * *lo, 2.0 * *hi));
+    }
+  }
+
+  // "table": diameters in increasing order, one mass fraction each, summing to 1.
+  static void read_fill_table(const TableReader& r, const Accepted& accepted, FillSpec& fill) {
+    require(r, deck::kFill, "sizes");
+    require(r, deck::kFill, "mass_fractions");
+    const auto sizes = accepted.get<deck::Numbers>("sizes");
+    const auto fractions = accepted.get<deck::Numbers>("mass_fractions");
+    if (sizes && !std::is_sorted(sizes->begin(), sizes->end(), std::less_equal<>())) {
+      r.invalid("sizes", "must be in increasing order, each size once (diameters, m)");
+    }
+    if (sizes) {
+      fill.radius_min = 0.5 * sizes->front();
+      fill.radius_max = 0.5 * sizes->back();
+    }
+    if (!fractions) return;
+    if (sizes && fractions->size() != sizes->size()) {
+      r.invalid("mass_fractions", fmt::format("{} values for {} sizes; give one per size",
+                                              fractions->size(), sizes->size()));
+      return;
+    }
+    double sum = 0.0;
+    for (const double w : *fractions) sum += w;
+    if (std::abs(sum - 1.0) > 1e-9) {
+      r.invalid("mass_fractions", fmt::format("sum to {:.12g}; must sum to 1 (within 1e-9)", sum));
+    }
+  }
+
+  // mix = true: placed with the fill before it, which must be placed (not read from a file)
+  // in the same region (the same box).
+  void read_fill_mix(const TableReader& r, const FillSpec& fill) const {
+    if (!fill.mix) return;
+    const std::string before = fmt::format("fill[{}]", fill.index - 1);
+    if (!previous_fill_) {
+      r.invalid("mix", "the first [[fill]] has no fill before it to mix with");
+    } else if (!previous_fill_->file.empty()) {
+      r.invalid("mix", fmt::format("{} reads a file; only placed fills mix", before));
+    } else if (previous_fill_->region != fill.region ||
+               (fill.region == FillRegion::kBox && (previous_fill_->box_min != fill.box_min ||
+                                                    previous_fill_->box_max != fill.box_max))) {
+      r.invalid("mix", fmt::format("{} is placed in another region; mixed fills share their "
+                                   "region (and box)",
+                                   before));
     }
   }
 
@@ -676,6 +804,7 @@ class DeckParser {
   // The deck's contact model; unset when it is invalid (model-dependent checks are skipped).
   std::optional<ContactModelKind> model_ = ContactModelKind::kHertzMindlin;
   std::vector<std::string> material_names_;  // by index; "" where the name was invalid
+  std::optional<FillSpec> previous_fill_;    // the [[fill]] read last (a file fill: its file)
   std::map<std::pair<std::string, std::string>, std::size_t> interaction_pairs_;
   std::vector<FileRows> file_rows_;  // the particles each [[fill]] file added, in order
 };
@@ -703,7 +832,8 @@ void record_where(const toml::table& root, const Diagnostics& diag, Scene& scene
     }
   };
   each("particle", {"velocity", "spin"});
-  each("fill", {"count", "fill_fraction", "radius", "radius_max", "velocity", "file"});
+  each("fill", {"count", "fill_fraction", "bed_filling", "radius", "radius_max", "sizes",
+                "velocity", "file"});
   each("wall", {"velocity"});
 }
 

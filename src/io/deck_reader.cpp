@@ -17,6 +17,8 @@ std::string expected_text(Type type, const Bound& bound) {
       return "an array of two numbers [x, y]";
     case Type::kMaterialPair:
       return "two material names [\"a\", \"b\"]";
+    case Type::kNumberList:
+      return bound.unbounded() ? "an array of numbers" : "an array of numbers " + bound.text();
     default:
       return "a string";  // kString, kMaterial, kChoice
   }
@@ -124,6 +126,35 @@ std::optional<Vec2> TableReader::pair(std::string_view key, Need need) const {
     return std::nullopt;
   }
   return Vec2{*xy[0], *xy[1]};
+}
+
+std::optional<std::vector<double>> TableReader::numbers(std::string_view key, const Bound& bound,
+                                                        Need need) const {
+  const std::string expected = expected_text(Type::kNumberList, bound);
+  const toml::node* node = find(key);
+  if (node == nullptr) {
+    if (need == Need::kRequired) missing(key, expected);
+    return std::nullopt;
+  }
+  const auto* array = node->as_array();
+  if (array == nullptr || array->empty()) {
+    invalid(key, "expected " + expected);
+    return std::nullopt;
+  }
+  std::vector<double> values;
+  for (std::size_t i = 0; i < array->size(); ++i) {
+    const toml::node& item = *array->get(i);
+    std::optional<double> v;
+    if (const auto* f = item.as_floating_point()) v = f->get();
+    if (const auto* n = item.as_integer()) v = static_cast<double>(n->get());
+    if (!v || !std::isfinite(*v) || !bound.contains(*v)) {
+      invalid(key, fmt::format("element {} = {}: expected {}", i, diag_.shown(item),
+                               v ? "a finite number " + bound.text() : expected));
+      return std::nullopt;
+    }
+    values.push_back(*v);
+  }
+  return values;
 }
 
 std::optional<std::string> TableReader::choice(std::string_view key,

@@ -83,6 +83,9 @@ class TableReader {
   std::optional<std::string> string(std::string_view key, Need need = Need::kOptional) const;
   // [x, y]: exactly two finite numbers (integers accepted).
   std::optional<Vec2> pair(std::string_view key, Need need = Need::kOptional) const;
+  // [a, b, ...]: one or more finite numbers, each in `bound`.
+  std::optional<std::vector<double>> numbers(std::string_view key, const Bound& bound,
+                                             Need need = Need::kOptional) const;
   // One of a fixed set of words; a near miss gets a suggestion.
   std::optional<std::string> choice(std::string_view key,
                                     std::span<const std::string_view> names) const;

@@ -44,6 +44,11 @@ std::string value_text(const Value& value, std::string (*number)(double)) {
     std::string operator()(Vec2 v) const {
       return fmt::format("[{}, {}]", number(v.x), number(v.y));
     }
+    std::string operator()(const Numbers& v) const {
+      std::string out = "[";
+      for (std::size_t i = 0; i < v.size(); ++i) out += (i > 0 ? ", " : "") + number(v[i]);
+      return out + "]";
+    }
     std::string operator()(const Names& v) const {
       std::string out = "[";
       for (std::size_t i = 0; i < v.size(); ++i) out += (i > 0 ? ", " : "") + quoted_string(v[i]);
@@ -116,6 +121,8 @@ std::string_view type_text(Type type) {
       return "float or `\"auto\"`";
     case Type::kMaterialPair:
       return "`[\"a\", \"b\"]`";
+    case Type::kNumberList:
+      return "array of floats";
     case Type::kTable:
     case Type::kTableArray:
       break;
@@ -149,6 +156,8 @@ std::string allowed_text(const Key<T>& key) {
       return "a defined name";
     case Type::kMaterialPair:
       return "two defined names";
+    case Type::kNumberList:
+      return "each " + key.range.doc_text();
     default:
       return "–";
   }

@@ -75,6 +75,12 @@ inline constexpr std::array kFillRegions = {
     Choice<FillRegion>{"box", FillRegion::kBox},
     Choice<FillRegion>{"annulus", FillRegion::kAnnulus},
 };
+inline constexpr std::array kSizeDistributions = {
+    Choice<SizeDistribution>{"uniform", SizeDistribution::kUniform},
+    Choice<SizeDistribution>{"normal", SizeDistribution::kNormal},
+    Choice<SizeDistribution>{"lognormal", SizeDistribution::kLognormal},
+    Choice<SizeDistribution>{"table", SizeDistribution::kTable},
+};
 
 // The word for `value` (choices are exhaustive, so one always matches).
 template <class E, std::size_t N>
@@ -111,6 +117,7 @@ enum class Type {
   kVector,        // [x, y]: exactly two numbers
   kNumberOrAuto,  // a number or "auto" (run.dt)
   kMaterialPair,  // two material names ["a", "b"] (interaction.materials)
+  kNumberList,    // [a, b, ...]: one or more numbers, each in the key's range
   kTable,         // a sub-table [name], described by its own Table
   kTableArray,    // an array of tables [[name]], described by its own Table
 };
@@ -140,8 +147,11 @@ inline constexpr Bound kPositive{0.0, Bound{}.hi, true, false};      // > 0
 inline constexpr Bound kNonNegative{0.0, Bound{}.hi, false, false};  // >= 0
 inline constexpr Bound kRestitution{0.0, 1.0, true, false};          // (0, 1]
 inline constexpr Bound kUnitFraction{0.0, 1.0, true, false};         // (0, 1]
-inline constexpr Bound kPoissonRatio{0.0, 0.5, false, true};  // [0, 0.5): isotropic, compressible
-inline constexpr Bound kFillFraction{0.0, 0.9, true, true};   // (0, 0.9): room left to place them
+inline constexpr Bound kPoissonRatio{0.0, 0.5, false, true};   // [0, 0.5): isotropic, compressible
+inline constexpr Bound kFillFraction{0.0, 0.9, true, true};    // (0, 0.9): room left to place them
+inline constexpr Bound kBedFilling{0.0, 1.0, true, true};      // (0, 1): J, the bed with its voids
+inline constexpr Bound kMassFraction{0.0, 1.0, false, false};  // [0, 1]
+inline constexpr Bound kGeometricSd{1.0, Bound{}.hi, true, false};  // > 1
 inline constexpr Bound kAtLeastOne{1.0, Bound{}.hi, false, false};  // >= 1 (integers)
 inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (integers)
 inline constexpr Bound kSizeRatio{1.1, 1e3, false, false};          // [1.1, 1000]
@@ -150,12 +160,14 @@ inline constexpr Bound kSizeEdge{1e-9, 10.0, false, true};          // [1 nm, 10
 // its mass rho 4/3 pi r^3 and moment of inertia 2/5 m r^2 leave the normal doubles (for steel
 // the inertia below about 5e-63 m, the mass below 1e-104 m: radius = 1e-120 has mass 0).
 inline constexpr double kMinRadius = 1e-9;
-inline constexpr Bound kRadius{kMinRadius, Bound{}.hi, false, false};  // >= 1 nm
+inline constexpr Bound kRadius{kMinRadius, Bound{}.hi, false, false};          // >= 1 nm
+inline constexpr Bound kDiameter{2.0 * kMinRadius, Bound{}.hi, false, false};  // >= 2 nm
 
 // A key's value once checked: a number, integer, bool, string (also a choice's word, or
-// "auto"), [x, y], or a list of names.
+// "auto"), [x, y], a list of names, or a list of numbers.
 using Names = std::vector<std::string>;
-using Value = std::variant<double, std::int64_t, bool, std::string, Vec2, Names>;
+using Numbers = std::vector<double>;
+using Value = std::variant<double, std::int64_t, bool, std::string, Vec2, Names, Numbers>;
 
 // The value as TOML writes it ("1e-6", "[0.0, -9.81]", "\"auto\"") and as JSON does.
 std::string toml_text(const Value& value);
@@ -231,7 +243,7 @@ V from_value(const Value& v) {
   } else if constexpr (std::is_integral_v<V>) {
     return static_cast<V>(std::get<std::int64_t>(v));  // the reader checked `max`
   } else {
-    return std::get<V>(v);  // std::string, Vec2
+    return std::get<V>(v);  // std::string, Vec2, Numbers
   }
 }
 
@@ -611,10 +623,18 @@ inline constexpr Key<LifterSpec> kLifterKeys[] = {
 };
 
 // Which keys a fill's resolved deck has: a file fill gives its file, material and velocity
-// only; a placed fill its count or fill fraction, radius or radius range, region and box.
+// only; a placed fill its count, fill fraction or bed filling, its sizes (radius or radius
+// range, a distribution's keys, a table), region and box; size_distribution and mix only
+// where they are not the default.
 inline bool placed(const FillSpec& f) { return f.file.empty(); }
-inline bool monodisperse(const FillSpec& f) { return placed(f) && f.radius_min == f.radius_max; }
-inline bool polydisperse(const FillSpec& f) { return placed(f) && f.radius_min != f.radius_max; }
+inline bool has_law(const FillSpec& f, SizeDistribution law) {
+  return placed(f) && f.size_distribution == law;
+}
+inline bool by_radius(const FillSpec& f) {  // radius, or radius_min and radius_max
+  return placed(f) && f.size_distribution != SizeDistribution::kTable;
+}
+inline bool monodisperse(const FillSpec& f) { return by_radius(f) && f.radius_min == f.radius_max; }
+inline bool polydisperse(const FillSpec& f) { return by_radius(f) && f.radius_min != f.radius_max; }
 inline bool in_box(const FillSpec& f) { return placed(f) && f.region == FillRegion::kBox; }
 
 inline constexpr Key<FillSpec> kFillKeys[] = {
@@ -629,7 +649,10 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .range = kAtLeastOne,
      .max = INT64_MAX,
      .field = member<&FillSpec::count>(),
-     .written_if = [](const FillSpec& f) { return placed(f) && f.fill_fraction <= 0.0; },
+     .written_if =
+         [](const FillSpec& f) {
+           return placed(f) && f.fill_fraction <= 0.0 && f.bed_filling <= 0.0;
+         },
      .default_text = "–",
      .doc = "place this many particles"},
     {.name = "fill_fraction",
@@ -639,6 +662,14 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .default_text = "–",
      .doc = "place particles until their total area Σ π r² is this fraction of the drum's "
             "cross-section (needs a `[drum]`)"},
+    {.name = "bed_filling",
+     .range = kBedFilling,
+     .field = member<&FillSpec::bed_filling>(),
+     .written_if = [](const FillSpec& f) { return placed(f) && f.bed_filling > 0.0; },
+     .default_text = "–",
+     .doc = "J, the bed with its voids over the drum's cross-section: place particles until Σ "
+            "π r² is J × 0.84 (the bed's packing) of the drum's cross-section (needs a "
+            "`[drum]`)"},
     {.name = "file",
      .type = Type::kString,
      .field = {nullptr,  // read as a CSV by the code after the per-key pass
@@ -663,7 +694,8 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .written_if = polydisperse,
      .default_text = "–",
      .allowed = "≥ 1e-09, ≤ `radius_max`",
-     .doc = "instead of `radius`: radii are drawn uniformly in [`radius_min`, `radius_max`]"},
+     .doc = "instead of `radius`: radii are drawn uniformly in [`radius_min`, `radius_max`]; "
+            "for a normal or lognormal law, the smallest radius it is truncated to"},
     {.name = "radius_max",
      .unit = "m",
      .range = kRadius,
@@ -671,7 +703,63 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .written_if = polydisperse,
      .default_text = "–",
      .allowed = "≥ 1e-09, ≥ `radius_min`",
-     .doc = "instead of `radius`: the largest radius (with `radius_min`)"},
+     .doc = "instead of `radius`: the largest radius (with `radius_min`); for a normal or "
+            "lognormal law, the largest radius it is truncated to"},
+    {.name = "size_distribution",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kSizeDistributions>,
+     .field = choice<&FillSpec::size_distribution, kSizeDistributions>(),
+     .written_if =
+         [](const FillSpec& f) {
+           return placed(f) && f.size_distribution != SizeDistribution::kUniform;
+         },
+     .doc = "the law of the sizes (below): uniform in radius between `radius_min` and "
+            "`radius_max` (or one `radius`), a normal or lognormal law of diameters by mass "
+            "truncated to [2 `radius_min`, 2 `radius_max`], or a table of sizes and mass "
+            "fractions"},
+    {.name = "d50",
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&FillSpec::d50>(),
+     .written_if =
+         [](const FillSpec& f) {
+           return has_law(f, SizeDistribution::kNormal) || has_law(f, SizeDistribution::kLognormal);
+         },
+     .default_text = "**required** with `\"normal\"`, `\"lognormal\"`",
+     .allowed = "in [2 `radius_min`, 2 `radius_max`]",
+     .doc = "the median diameter by mass (half the charge's mass is in smaller particles); "
+            "for `\"normal\"` also the mean"},
+    {.name = "sigma",
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&FillSpec::sigma>(),
+     .written_if = [](const FillSpec& f) { return has_law(f, SizeDistribution::kNormal); },
+     .default_text = "**required** with `\"normal\"`",
+     .doc = "`\"normal\"`: the standard deviation of the diameter by mass"},
+    {.name = "geometric_sd",
+     .range = kGeometricSd,
+     .field = member<&FillSpec::geometric_sd>(),
+     .written_if = [](const FillSpec& f) { return has_law(f, SizeDistribution::kLognormal); },
+     .default_text = "**required** with `\"lognormal\"`",
+     .doc = "`\"lognormal\"`: the geometric standard deviation of the diameter by mass, the "
+            "exponential of the standard deviation of ln d (d84 / d50)"},
+    {.name = "sizes",
+     .type = Type::kNumberList,
+     .unit = "m",
+     .range = kDiameter,
+     .field = member<&FillSpec::sizes>(),
+     .written_if = [](const FillSpec& f) { return has_law(f, SizeDistribution::kTable); },
+     .default_text = "**required** with `\"table\"`",
+     .allowed = "each ≥ 2e-09, increasing",
+     .doc = "`\"table\"`: the particles' diameters"},
+    {.name = "mass_fractions",
+     .type = Type::kNumberList,
+     .range = kMassFraction,
+     .field = member<&FillSpec::mass_fractions>(),
+     .written_if = [](const FillSpec& f) { return has_law(f, SizeDistribution::kTable); },
+     .default_text = "**required** with `\"table\"`",
+     .allowed = "each in [0, 1], one per size, summing to 1 (within 1e-9)",
+     .doc = "`\"table\"`: the share of the fill's mass in particles of each size"},
     {.name = "region",
      .type = Type::kChoice,
      .choices = kChoiceNames<kFillRegions>,
@@ -699,6 +787,12 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .unit = "m/s",
      .field = member<&FillSpec::velocity>(),
      .doc = "initial velocity of every particle of the fill"},
+    {.name = "mix",
+     .type = Type::kBool,
+     .field = member<&FillSpec::mix>(),
+     .written_if = [](const FillSpec& f) { return f.mix; },
+     .doc = "place this fill together with the `[[fill]]` just before it (same region), "
+            "their particles interleaved at random in one bed, instead of after it (below)"},
 };
 
 inline constexpr Key<ParticleSpec> kParticleKeys[] = {
@@ -1007,12 +1101,12 @@ bool is_table_array(std::string_view path);
 // drum.speed).
 struct AlternativeKeys {
   std::string_view table;                // schema path: "drum", "fill", "material"
-  std::array<std::string_view, 3> keys;  // unused entries empty
+  std::array<std::string_view, 4> keys;  // unused entries empty
 };
 inline constexpr std::array<AlternativeKeys, 3> kAlternativeKeys{{
-    {"drum", {"speed", "speed_rpm", "critical_fraction"}},
-    {"fill", {"count", "fill_fraction", "file"}},
-    {"material", {"poisson_ratio", "shear_modulus", ""}},
+    {"drum", {"speed", "speed_rpm", "critical_fraction", ""}},
+    {"fill", {"count", "fill_fraction", "bed_filling", "file"}},
+    {"material", {"poisson_ratio", "shear_modulus", "", ""}},
 }};
 
 // The key named `name` of a table (nullptr: none).

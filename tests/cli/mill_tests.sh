@@ -1,9 +1,12 @@
 #!/bin/bash
 # The mill's variables and analytics through the command line:
 #   - --set of one speed key replaces the deck's other one (speed, speed_rpm,
-#     critical_fraction), a fill's count gives way to a fill fraction; two alternatives both set
-#     on the command line are refused;
-#   - --check prints the critical speeds, the fraction of critical, the bed filling J and the
+#     critical_fraction), a fill's count gives way to a fill fraction or a bed filling; two
+#     alternatives both set on the command line are refused;
+#   - fills by bed filling, of each law of sizes and mixed place the same particles on 1 and 3
+#     ranks (snapshots bit for bit);
+#   - --check prints the critical speeds, the fraction of critical, the bed filling J (and the
+#     fill that asked it) and the
 #     2D-to-3D slice thickness; run.json's "mill" object holds them with the regime;
 #   - the collision spectra (collisions.csv) count the same contacts on 1 and 3 ranks, and a
 #     run resumed from a checkpoint on another rank count ends with the same spectra.
@@ -29,6 +32,12 @@ expect "speed_rpm replaces speed" 0 'drum speed: +1\.0472 rad/s = 0\.529 of crit
   "$dem2d" --check --set drum.speed_rpm=10 "$wf"
 expect "fill_fraction replaces count" 0 'fill fraction: +0\.30' -- \
   "$dem2d" --check --set fill.0.fill_fraction=0.3 "$wf"
+expect "bed_filling replaces count" 0 'bed filling J: +0\.30[0-9] \(the bed with its voids / drum area, packing 0\.84; asked: fill\[0\]\.bed_filling = 0\.3\)$' -- \
+  "$dem2d" --check --set fill.0.bed_filling=0.3 "$wf"
+expect "fill_fraction asked" 0 'fill fraction: +0\.30[0-9]{2} \(particle cross-sections / drum area; asked: fill\[0\]\.fill_fraction = 0\.3\)$' -- \
+  "$dem2d" --check --set fill.0.fill_fraction=0.3 "$wf"
+expect "count asks neither" 0 'bed filling J: +0\.457 \(the bed with its voids / drum area, packing 0\.84\)$' -- \
+  "$dem2d" --check "$wf"
 expect "two speeds on the command line" 2 'give only one of speed, speed_rpm and critical_fraction' -- \
   "$dem2d" --check --set drum.speed_rpm=10 --set drum.critical_fraction=0.7 "$wf"
 expect "two speeds on 2 ranks" 2 'give only one of speed, speed_rpm and critical_fraction' -- \
@@ -113,6 +122,58 @@ assert j["particle_steps"] == j["particles"] * j["steps"] == 240 * j["steps"], j
 print(m["regime"], round(m["power_avg_W"]), "W")
 EOF
 ); then pass "run.json mill: $out"; else fail "run.json mill: $out"; fi
+
+# Fills of each law of sizes, mixed and by bed filling: the same particles on 1 and 3 ranks
+# (placement draws from the seed alone), snapshots compared bit for bit.
+cat > "$tmp/sizes.in" <<'EOF'
+title = "sizes"
+[run]
+duration = 0.0004
+[[material]]
+name = "steel"
+density = 7800.0
+youngs_modulus = 2.0e11
+[[material]]
+name = "ore"
+density = 3000.0
+youngs_modulus = 5.0e10
+[drum]
+radius = 0.5
+speed = 2.0
+material = "steel"
+[[fill]]
+material = "steel"
+bed_filling = 0.15
+size_distribution = "normal"
+d50 = 0.04
+sigma = 0.008
+radius_min = 0.014
+radius_max = 0.026
+[[fill]]
+material = "ore"
+count = 150
+size_distribution = "lognormal"
+d50 = 0.02
+geometric_sd = 1.5
+radius_min = 0.004
+radius_max = 0.015
+mix = true
+[[fill]]
+material = "ore"
+count = 60
+size_distribution = "table"
+sizes = [0.01, 0.02]
+mass_fractions = [0.4, 0.6]
+[output]
+snapshot_interval = 0.0002
+EOF
+"$dem2d" --quiet "$tmp/sizes.in" --output "$tmp/sz1" > "$tmp/sz1.log" 2>&1 || fail "sizes np1: $(cat "$tmp/sz1.log")"
+mpirun -np 3 --oversubscribe "$dem2d" --quiet "$tmp/sizes.in" --output "$tmp/sz3" > "$tmp/sz3.log" 2>&1 ||
+  fail "sizes np3: $(cat "$tmp/sz3.log")"
+expect "sizes and mix: np3 snapshots identical to np1" 0 'bit-identical' -- "$py" "$src/post/h5compare.py" \
+  "$tmp/sz1/snapshots.h5" "$tmp/sz3/snapshots.h5"
+expect "sizes: --check asks the bed filling" 0 'asked: fill\[0\]\.bed_filling = 0\.15\)$' -- \
+  "$dem2d" --check "$tmp/sizes.in"
 
 if [ "$failures" -gt 0 ]; then
   echo "$failures mill test(s) failed"

@@ -858,7 +858,7 @@ radius = 0.1
 )");
   EXPECT_TRUE(has_message(messages,
                           "deck.in:12:1: error: fill[0]: give only one of count, "
-                          "fill_fraction and file (found count and fill_fraction)"));
+                          "fill_fraction, bed_filling and file (found count and fill_fraction)"));
   EXPECT_TRUE(has_message(messages,
                           "deck.in:15:17: error: fill[0].fill_fraction = 0.3: needs "
                           "a [drum] (it is a fraction of the drum's area)"));
@@ -877,6 +877,148 @@ radius = 0.1
                           "deck.in:20:17: error: fill[1].fill_fraction = 0.3: needs "
                           "a [drum] (it is a fraction of the drum's area)"));
   EXPECT_EQ(messages.size(), 7u);
+}
+
+// A drum deck with one [[fill]] whose keys are `fill_keys`.
+std::string drum_fill_deck(const std::string& fill_keys) {
+  return kMinimalDeck +
+         "\n[drum]\nradius = 1.0\nmaterial = \"steel\"\n\n[[fill]]\nmaterial = "
+         "\"steel\"\n" +
+         fill_keys;
+}
+
+TEST(DeckErrors, FillBedFilling) {
+  // Beside a fill fraction, out of range, and without a drum.
+  auto messages =
+      deck_errors(drum_fill_deck("bed_filling = 0.3\nfill_fraction = 0.2\nradius = 0.05\n"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:16:1: error: fill[0]: give only one of count, fill_fraction, "
+                          "bed_filling and file (found fill_fraction and bed_filling)"))
+      << messages[0];
+  messages = deck_errors(drum_fill_deck("bed_filling = 1.0\nradius = 0.05\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0], "deck.in:18:15: error: fill[0].bed_filling = 1.0: must be in (0, 1)");
+  messages = deck_errors(kMinimalDeck +
+                         "[[fill]]\nmaterial = \"steel\"\nbed_filling = 0.3\nradius = 0.05\n"
+                         "region = \"box\"\nbox_min = [0, 0]\nbox_max = [1, 1]\n");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:13:15: error: fill[0].bed_filling = 0.3: needs a [drum] (it is "
+                          "a fraction of the drum's area)"));
+}
+
+TEST(DeckErrors, FillSizeDistributions) {
+  // Keys of another law; a d50 outside the truncation; a missing spread.
+  auto messages = deck_errors(drum_fill_deck(
+      "count = 10\nsize_distribution = \"normal\"\nd50 = 0.5\nradius = 0.05\nradius_min = "
+      "0.01\nradius_max = 0.03\ngeometric_sd = 1.5\n"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:21:10: error: fill[0].radius = 0.05: not used by "
+                          "size_distribution = \"normal\", which takes d50, sigma, radius_min "
+                          "and radius_max"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:24:16: error: fill[0].geometric_sd = 1.5: not used by "
+                          "size_distribution = \"normal\", which takes d50, sigma, radius_min "
+                          "and radius_max"));
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:16:1: error: fill[0].sigma is required (a number > 0)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:20:7: error: fill[0].d50 = 0.5: must lie within [2 radius_min, "
+                          "2 radius_max] = [0.02, 0.06] m (a diameter, within the truncation)"));
+  messages = deck_errors(drum_fill_deck("count = 10\nradius = 0.05\nd50 = 0.1\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "deck.in:20:7: error: fill[0].d50 = 0.1: not used by size_distribution = "
+            "\"uniform\" (the default), which takes radius, or radius_min and radius_max");
+  messages = deck_errors(drum_fill_deck(
+      "count = 10\nsize_distribution = \"lognormal\"\nd50 = 0.04\ngeometric_sd = 1.0\n"
+      "radius_min = 0.02\nradius_max = 0.02\n"));
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:21:16: error: fill[0].geometric_sd = 1.0: must be > 1"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:22:14: error: fill[0].radius_min = 0.02: must be < radius_max "
+                          "= 0.02 (the truncation of the lognormal law)"));
+}
+
+TEST(DeckErrors, FillSizeTable) {
+  auto messages = deck_errors(drum_fill_deck(
+      "count = 10\nsize_distribution = \"table\"\nsizes = [0.02, 0.04]\nmass_fractions = [0.5, "
+      "0.4999]\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "deck.in:21:18: error: fill[0].mass_fractions = [0.5, 0.4999]: sum to 0.9999; must "
+            "sum to 1 (within 1e-9)");
+  messages = deck_errors(drum_fill_deck(
+      "count = 10\nsize_distribution = \"table\"\nsizes = [0.04, 0.02, -1]\nmass_fractions = "
+      "[0.5, 0.5]\nradius = 0.1\n"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:20:9: error: fill[0].sizes = [0.04, 0.02, -1]: element 2 = -1: "
+                          "expected a finite number >= 2e-09"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:22:10: error: fill[0].radius = 0.1: not used by "
+                          "size_distribution = \"table\", which takes sizes and mass_fractions"));
+  messages = deck_errors(drum_fill_deck(
+      "count = 10\nsize_distribution = \"table\"\nsizes = [0.04, 0.02]\nmass_fractions = "
+      "[0.5, 0.25, 0.25]\n"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:20:9: error: fill[0].sizes = [0.04, 0.02]: must be in "
+                          "increasing order, each size once (diameters, m)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:21:18: error: fill[0].mass_fractions = [0.5, 0.25, 0.25]: 3 "
+                          "values for 2 sizes; give one per size"));
+}
+
+TEST(DeckErrors, FillMix) {
+  auto messages = deck_errors(drum_fill_deck("count = 10\nradius = 0.05\nmix = true\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "deck.in:20:7: error: fill[0].mix = true: the first [[fill]] has no fill before it "
+            "to mix with");
+  messages =
+      deck_errors(drum_fill_deck("count = 10\nradius = 0.05\n\n[[fill]]\nmaterial = "
+                                 "\"steel\"\ncount = 5\nradius = 0.02\nregion = "
+                                 "\"annulus\"\nmix = true\n"));
+  ASSERT_EQ(messages.size(), 1u);
+  EXPECT_EQ(messages[0],
+            "deck.in:26:7: error: fill[1].mix = true: fill[0] is placed in another region; "
+            "mixed fills share their region (and box)");
+}
+
+TEST(Deck, FillSizesBedFillingAndMixAreRead) {
+  const Scene s = parse_deck_string(
+      drum_fill_deck("bed_filling = 0.35\nsize_distribution = \"table\"\nsizes = [0.02, 0.04]\n"
+                     "mass_fractions = [0.25, 0.75]\n\n[[fill]]\nmaterial = \"steel\"\ncount = "
+                     "20\nsize_distribution = \"lognormal\"\nd50 = 0.03\ngeometric_sd = 1.4\n"
+                     "radius_min = 0.01\nradius_max = 0.02\nmix = true\n"),
+      "deck.in");
+  ASSERT_EQ(s.fills.size(), 2u);
+  EXPECT_EQ(s.fills[0].bed_filling, 0.35);
+  EXPECT_EQ(s.fills[0].count, 0);
+  EXPECT_EQ(s.fills[0].size_distribution, SizeDistribution::kTable);
+  EXPECT_EQ(s.fills[0].sizes, (std::vector<double>{0.02, 0.04}));
+  EXPECT_EQ(s.fills[0].mass_fractions, (std::vector<double>{0.25, 0.75}));
+  EXPECT_EQ(s.fills[0].radius_min, 0.01);  // half the sizes: the lattice's spacing
+  EXPECT_EQ(s.fills[0].radius_max, 0.02);
+  EXPECT_FALSE(s.fills[0].mix);
+  EXPECT_EQ(s.fills[1].size_distribution, SizeDistribution::kLognormal);
+  EXPECT_EQ(s.fills[1].d50, 0.03);
+  EXPECT_EQ(s.fills[1].geometric_sd, 1.4);
+  EXPECT_TRUE(s.fills[1].mix);
+}
+
+// --set fill.0.bed_filling replaces the deck's count or fill_fraction, as fill_fraction does.
+TEST(DeckOverrides, BedFillingReplacesCountAndFillFraction) {
+  for (const std::string source : {"count = 10\n", "fill_fraction = 0.2\n"}) {
+    const Scene s = parse_deck_string(drum_fill_deck(source + "radius = 0.05\n"), "deck.in",
+                                      {"fill.0.bed_filling=0.3"});
+    EXPECT_EQ(s.fills[0].bed_filling, 0.3);
+    EXPECT_EQ(s.fills[0].count, 0);
+    EXPECT_EQ(s.fills[0].fill_fraction, 0.0);
+    EXPECT_TRUE(s.where.at("fill[0].bed_filling").starts_with("--set fill.0.bed_filling=0.3"));
+  }
+  const Scene s = parse_deck_string(drum_fill_deck("bed_filling = 0.3\nradius = 0.05\n"), "deck.in",
+                                    {"fill.0.count=7"});
+  EXPECT_EQ(s.fills[0].count, 7);
+  EXPECT_EQ(s.fills[0].bed_filling, 0.0);
 }
 
 TEST(DeckErrors, WallsAndOutput) {
@@ -1272,6 +1414,18 @@ material = "steel"
                     {"material.steel.normal_stiffness=3.3e5", "material.steel.restitution=0.9"});
 }
 
+TEST(DeckResolved, ReadsBackFillSizesBedFillingAndMix) {
+  const TempDir dir;
+  expect_round_trip(
+      dir, drum_fill_deck("bed_filling = 0.35\nsize_distribution = \"table\"\nsizes = [0.02, "
+                          "0.04]\nmass_fractions = [0.25, 0.75]\n\n[[fill]]\nmaterial = "
+                          "\"steel\"\ncount = 20\nsize_distribution = \"lognormal\"\nd50 = "
+                          "0.03\ngeometric_sd = 1.4\nradius_min = 0.01\nradius_max = 0.02\n"
+                          "mix = true\n\n[[fill]]\nmaterial = \"steel\"\ncount = 20\n"
+                          "size_distribution = \"normal\"\nd50 = 0.03\nsigma = 0.005\n"
+                          "radius_min = 0.01\nradius_max = 0.02\n"));
+}
+
 TEST(DeckResolved, WritesEveryDefault) {
   const std::string resolved = resolved_deck_toml(parse_deck_string(kMinimalDeck, "min.in"));
   for (const char* line :
@@ -1357,6 +1511,8 @@ std::vector<deck::Value> sample_values(const deck::Key<T>& key) {
       return {Vec2{1.5, -2.5}};
     case deck::Type::kMaterialPair:
       return {deck::Names{"a", "b"}};
+    case deck::Type::kNumberList:
+      return {deck::Numbers{0.25, 0.75}, deck::Numbers{1.5}};
     default:
       return {std::string("steel")};
   }
@@ -1514,6 +1670,8 @@ Case wrong_type(std::string_view table, bool repeated, std::string_view key, dec
     case deck::Type::kMaterialPair:
       return make_case(table, repeated, key, "2.5", "2.5",
                        "expected two material names [\"a\", \"b\"]");
+    case deck::Type::kNumberList:
+      return make_case(table, repeated, key, "2.5", "2.5", "expected an array of numbers" + range);
     default:  // kString, kMaterial
       return make_case(table, repeated, key, "2.5", "2.5", "expected a string");
   }

@@ -107,14 +107,25 @@ struct DrumSpec {
 
 enum class FillRegion { kBottom, kFull, kBox, kAnnulus };
 
+// A placed fill's law of sizes (core/setup/size_law.hpp).
+enum class SizeDistribution { kUniform, kNormal, kLognormal, kTable };
+
 struct FillSpec {
   std::string material;
-  // Exactly one source: count, fill_fraction, or file (a CSV packing).
+  // Exactly one source: count, fill_fraction, bed_filling, or file (a CSV packing).
   std::int64_t count = 0;
   double fill_fraction = 0.0;  // of the drum's cross-section area (sum of pi r^2)
+  double bed_filling = 0.0;    // J: sum of pi r^2 = J kBedPacking (drum area)
   std::string file;            // resolved to an absolute path by the parser
   double radius_min = 0.0;     // mono-disperse: radius_min == radius_max
-  double radius_max = 0.0;
+  double radius_max = 0.0;     // a table: half its smallest and largest size
+  SizeDistribution size_distribution = SizeDistribution::kUniform;
+  double d50 = 0.0;                    // m, normal and lognormal: the median diameter by mass
+  double sigma = 0.0;                  // m, normal: the standard deviation of the diameter by mass
+  double geometric_sd = 0.0;           // lognormal: exp of the standard deviation of ln(diameter)
+  std::vector<double> sizes;           // m, table: diameters, increasing
+  std::vector<double> mass_fractions;  // table: the mass share of each size, summing to 1
+  bool mix = false;                    // placed together with the fill before it, interleaved
   FillRegion region = FillRegion::kBottom;
   Vec2 box_min{0.0, 0.0};  // region = "box"
   Vec2 box_max{0.0, 0.0};

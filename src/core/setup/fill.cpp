@@ -11,6 +11,7 @@
 #include "core/base/errors.hpp"
 #include "core/base/random.hpp"
 #include "core/geometry/drum_geometry.hpp"
+#include "core/setup/size_law.hpp"
 #include "core/setup/validate.hpp"
 #include "core/shape/disc.hpp"
 
@@ -18,39 +19,34 @@ namespace dem2d {
 
 namespace {
 
-constexpr std::uint64_t kFillStream = 0xF111ULL << 32;
-
-double fill_radius(const Scene& scene, std::size_t f, std::int64_t k) {
-  const FillSpec& s = scene.fills[f];
-  if (s.radius_max <= s.radius_min) return s.radius_min;
-  const double u = random_uniform(scene.run.seed, kFillStream + f, static_cast<std::uint64_t>(k));
-  return s.radius_min + u * (s.radius_max - s.radius_min);
-}
-
 // "deck.in:14:9: error: fill[0].count = 5000: ", at the key that sets how many the fill places
 // (Scene::where), else at the fill's line.
 std::string where(const Scene& scene, const FillSpec& s) {
   const std::string fill = "fill[" + std::to_string(s.index) + "]";
-  const std::string key = fill + (s.count > 0 ? ".count" : ".fill_fraction");
+  std::ostringstream value;
+  std::string key = fill + ".count";
+  if (s.count > 0) {
+    value << s.count;
+  } else if (s.bed_filling > 0.0) {
+    key = fill + ".bed_filling";
+    value << s.bed_filling;
+  } else {
+    key = fill + ".fill_fraction";
+    value << s.fill_fraction;
+  }
   const auto it = scene.where.find(key);
   if (it == scene.where.end())
     return scene.deck_path + ":" + std::to_string(s.source_line) + ": error: " + fill + ": ";
-  std::ostringstream value;
-  if (s.count > 0) {
-    value << s.count;
-  } else {
-    value << s.fill_fraction;
-  }
   return it->second + ": error: " + key + " = " + value.str() + ": ";
 }
 
-// Uniform grid of placed particles for overlap checks.
+// Uniform grid of placed particles (their centres and radii) for overlap checks.
 class PlacedGrid {
  public:
-  PlacedGrid(const ParticleStore& p, double cell) : p_(p), h_(cell) {
-    for (std::size_t k = 0; k < p.size(); ++k) insert(k);
+  PlacedGrid(const ParticleStore& p, double cell) : h_(cell) {
+    for (std::size_t k = 0; k < p.size(); ++k) insert(p.pos[k], p.radius[k]);
   }
-  void insert(std::size_t k) { cells_[key(p_.pos[k])].push_back(k); }
+  void insert(Vec2 x, double r) { cells_[key(x)].push_back({x, r}); }
   bool overlaps(Vec2 x, double r, double r_max) const {
     const auto [cx, cy] = index(x);
     const int reach = static_cast<int>(std::ceil((r + r_max) / h_));
@@ -58,9 +54,9 @@ class PlacedGrid {
       for (int dx = -reach; dx <= reach; ++dx) {
         auto it = cells_.find(pack(cx + dx, cy + dy));
         if (it == cells_.end()) continue;
-        for (std::size_t k : it->second) {
-          const double s = r + p_.radius[k];
-          if (norm2(p_.pos[k] - x) < s * s) return true;
+        for (const Disc& d : it->second) {
+          const double s = r + d.r;
+          if (norm2(d.x - x) < s * s) return true;
         }
       }
     return false;
@@ -77,25 +73,20 @@ class PlacedGrid {
     const auto [a, b] = index(x);
     return pack(a, b);
   }
-  const ParticleStore& p_;
+  struct Disc {
+    Vec2 x;
+    double r;
+  };
   double h_;
-  std::unordered_map<long long, std::vector<std::size_t>> cells_;
+  std::unordered_map<long long, std::vector<Disc>> cells_;
 };
 
 }  // namespace
 
 std::int64_t fill_count(const Scene& scene, std::size_t f) {
   const FillSpec& s = scene.fills[f];
-  if (s.count > 0) return s.count;
-  const double target = s.fill_fraction * std::numbers::pi * scene.drum.radius * scene.drum.radius;
-  double area = 0.0;
-  std::int64_t k = 0;
-  while (area < target) {
-    const double r = fill_radius(scene, f, k);
-    area += std::numbers::pi * r * r;
-    ++k;
-  }
-  return k;
+  if (s.count > 0) return s.count;  // a table apportions exactly its count
+  return static_cast<std::int64_t>(fill_radii(scene, f).size());
 }
 
 namespace {
@@ -110,11 +101,11 @@ struct Site {
 // the sites that touch a wall or a particle already placed, each with its key (random for
 // `full` and `box`, by row for `bottom`, by distance from the shell for `annulus`).
 std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const ParticleStore& store,
-                             std::size_t f, double r_all_max) {
+                             std::size_t f, double radius_max, double r_all_max) {
   const FillSpec& s = scene.fills[f];
   const bool needs_drum = s.region != FillRegion::kBox;
   const DrumGeometry drum(scene.drum);
-  const double spacing = 2.1 * s.radius_max;
+  const double spacing = 2.1 * radius_max;
   const double row = spacing * std::sqrt(3.0) / 2.0;
   Vec2 lo = s.box_min, hi = s.box_max;
   const Vec2 c = scene.drum.center;
@@ -149,6 +140,127 @@ std::vector<Site> fill_sites(const Scene& scene, const Walls& walls, const Parti
   return sites;
 }
 
+// Fills [first, last) placed together: one fill, or one and the fills after it that mix with it
+// (mix = true).
+struct Group {
+  std::size_t first = 0, last = 0;
+};
+
+std::string group_names(const Group& g, const Scene& scene) {
+  std::string names;
+  for (std::size_t f = g.first; f < g.last; ++f)
+    names += (f == g.first      ? ""
+              : f + 1 == g.last ? " and "
+                                : ", ") +
+             std::string("fill[") + std::to_string(scene.fills[f].index) + "]";
+  return names;
+}
+
+// Jitter of particle k of fill f within its site's slack, half - r: the site's circle of radius
+// half (half the spacing) holds the sphere.
+Vec2 jitter(const Scene& scene, std::size_t f, std::size_t k, double slack) {
+  const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
+  const double jy = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
+  return (slack * 0.7071) * Vec2{jx, jy};
+}
+
+std::string do_not_fit(const Scene& scene, std::size_t f, std::size_t n, std::size_t sites,
+                       const std::string& mixed) {
+  std::ostringstream o;
+  o << n << " particles do not fit: the region holds " << sites
+    << " clear of the walls and the particles placed before, at radius_max "
+    << scene.fills[f].radius_max << " m" << mixed
+    << "; lower count, fill_fraction or bed_filling, or enlarge the region";
+  return where(scene, scene.fills[f]) + o.str();
+}
+
+// One fill alone: its particles at the first sites of its lattice, in id order.
+void place_fill(const Scene& scene, const Walls& walls, ParticleStore& store, std::size_t f,
+                double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const FillSpec& s = scene.fills[f];
+  const std::vector<double> r = fill_radii(scene, f);
+  std::vector<Site> sites = fill_sites(scene, walls, store, f, s.radius_max, r_all_max);
+  if (sites.size() < r.size()) {
+    errors.push_back(do_not_fit(scene, f, r.size(), sites.size(), ""));
+    return;
+  }
+  std::stable_sort(sites.begin(), sites.end(),
+                   [](const Site& a, const Site& b) { return a.key < b.key; });
+  const int mat = find_material(scene, s.material);
+  const double spacing = 2.1 * s.radius_max;  // as in fill_sites
+  const double half = 0.5 * spacing;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    const Vec2 x = sites[k].x + jitter(scene, f, k, half - r[k]);
+    store.add(next_id++, mat, r[k], scene.materials[mat].density, x, s.velocity, 0.0);
+  }
+}
+
+// Mixed fills: each keeps its own lattice, sorted as its region says; the group's particles
+// are dealt in an order shuffled by (seed, first fill), each fill's in proportion to their
+// numbers, and each takes the next site of its own lattice (the lowest free one for "bottom")
+// that is clear of the particles the group placed before it. Ids follow the deck's order.
+void place_mixed(const Scene& scene, const Walls& walls, ParticleStore& store, const Group& g,
+                 double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const std::size_t m = g.last - g.first;
+  std::vector<std::vector<double>> radii(m);
+  std::vector<std::vector<Site>> sites(m);
+  std::vector<std::vector<Vec2>> at(m);
+  std::vector<std::size_t> owner;  // the fill (0 .. m-1) of each particle dealt
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t f = g.first + i;
+    radii[i] = fill_radii(scene, f);
+    sites[i] = fill_sites(scene, walls, store, f, scene.fills[f].radius_max, r_all_max);
+    std::stable_sort(sites[i].begin(), sites[i].end(),
+                     [](const Site& a, const Site& b) { return a.key < b.key; });
+    owner.insert(owner.end(), radii[i].size(), i);
+  }
+  for (std::size_t j = owner.size(); j > 1; --j) {  // Fisher-Yates
+    const double u = random_uniform(scene.run.seed, kFillStream + 4000 + g.first, j - 1);
+    std::swap(owner[j - 1],
+              owner[std::min(static_cast<std::size_t>(u * static_cast<double>(j)), j - 1)]);
+  }
+  PlacedGrid placed(store, 2.0 * r_all_max);
+  std::vector<std::size_t> next(m, 0);
+  for (const std::size_t i : owner) {
+    const std::size_t f = g.first + i, k = at[i].size();
+    const double r = radii[i][k];
+    const Vec2 offset = jitter(scene, f, k, 0.5 * (2.1 * scene.fills[f].radius_max) - r);
+    while (next[i] < sites[i].size() && placed.overlaps(sites[i][next[i]].x + offset, r, r_all_max))
+      ++next[i];
+    if (next[i] == sites[i].size()) {
+      errors.push_back(
+          do_not_fit(scene, f, radii[i].size(), k,
+                     " beside the fills it mixes with (" + group_names(g, scene) + ")"));
+      return;
+    }
+    at[i].push_back(sites[i][next[i]++].x + offset);
+    placed.insert(at[i].back(), r);
+  }
+  for (std::size_t i = 0; i < m; ++i) {
+    const FillSpec& s = scene.fills[g.first + i];
+    const int mat = find_material(scene, s.material);
+    for (std::size_t k = 0; k < at[i].size(); ++k)
+      store.add(next_id++, mat, radii[i][k], scene.materials[mat].density, at[i][k], s.velocity,
+                0.0);
+  }
+}
+
+// One group: one fill placed alone, or mixed fills placed together.
+void place_group(const Scene& scene, const Walls& walls, ParticleStore& store, const Group& g,
+                 double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
+  const FillSpec& head = scene.fills[g.first];
+  if (head.region != FillRegion::kBox && !scene.drum.present) {
+    errors.push_back(where(scene, head) +
+                     "region needs a [drum]; use region = \"box\" with box_min and box_max");
+    return;
+  }
+  if (g.last - g.first == 1) {
+    place_fill(scene, walls, store, g.first, r_all_max, next_id, errors);
+  } else {
+    place_mixed(scene, walls, store, g, r_all_max, next_id, errors);
+  }
+}
+
 }  // namespace
 
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store) {
@@ -165,38 +277,11 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   for (const FillSpec& s : scene.fills) r_all_max = std::max(r_all_max, s.radius_max);
   if (r_all_max <= 0.0) return;
 
-  for (std::size_t f = 0; f < scene.fills.size(); ++f) {
-    const FillSpec& s = scene.fills[f];
-    if (s.region != FillRegion::kBox && !scene.drum.present) {
-      errors.push_back(where(scene, s) +
-                       "region needs a [drum]; use region = \"box\" with box_min and box_max");
-      continue;
-    }
-    const std::int64_t n = fill_count(scene, f);
-    std::vector<Site> sites = fill_sites(scene, walls, store, f, r_all_max);
-    if (static_cast<std::int64_t>(sites.size()) < n) {
-      std::ostringstream o;
-      o << n << " particles do not fit: the region holds " << sites.size()
-        << " clear of the walls and the particles placed before, at radius_max " << s.radius_max
-        << " m; lower count or fill_fraction, or enlarge the region";
-      errors.push_back(where(scene, s) + o.str());
-      continue;
-    }
-    std::stable_sort(sites.begin(), sites.end(),
-                     [](const Site& a, const Site& b) { return a.key < b.key; });
-    const int mat = find_material(scene, s.material);
-    const double spacing = 2.1 * s.radius_max;  // as in fill_sites
-    const double half = 0.5 * spacing;
-    for (std::int64_t k = 0; k < n; ++k) {
-      const double r = fill_radius(scene, f, k);
-      // Jitter within the site's slack: the site's circle of radius spacing/2 holds the sphere.
-      const double slack = half - r;
-      const double jx = random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k) * 2.0 - 1.0;
-      const double jy =
-          random_uniform(scene.run.seed, kFillStream + 2000 + f, 2 * k + 1) * 2.0 - 1.0;
-      const Vec2 x = sites[k].x + (slack * 0.7071) * Vec2{jx, jy};
-      store.add(next_id++, mat, r, scene.materials[mat].density, x, s.velocity, 0.0);
-    }
+  for (std::size_t f = 0; f < scene.fills.size();) {
+    Group g{f, f + 1};
+    while (g.last < scene.fills.size() && scene.fills[g.last].mix) ++g.last;
+    place_group(scene, walls, store, g, r_all_max, next_id, errors);
+    f = g.last;
   }
   if (!errors.empty()) throw InputError(errors);
 }

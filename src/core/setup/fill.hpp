@@ -6,7 +6,10 @@
 // or an earlier particle. Regions: "bottom" takes the lowest sites in the drum (row by row, the
 // last row chosen at random), "full" a random subset of all sites in the drum, "annulus" the
 // sites nearest the shell first, "box" a random subset of the sites in [box_min, box_max].
-// Radii are uniform in [radius_min, radius_max]; every draw is keyed by (seed, fill, particle).
+// A fill with mix = true is placed together with the fill before it: each keeps its lattice,
+// their particles dealt in a shuffled order, each to its lattice's next site clear of those
+// placed. Radii follow the fill's size_distribution (size_law.hpp); every draw is keyed by
+// (seed, fill, particle), so every rank places the same particles.
 #pragma once
 
 #include "core/base/scene.hpp"
@@ -20,7 +23,7 @@ namespace dem2d {
 // the machine's memory (check_memory, before any is placed) or a region cannot hold them.
 void place_particles(const Scene& scene, const Walls& walls, ParticleStore& store);
 
-// Number of particles a fill will place (after resolving fill_fraction).
+// Number of particles a fill will place (after resolving fill_fraction or bed_filling).
 std::int64_t fill_count(const Scene& scene, std::size_t fill_index);
 
 }  // namespace dem2d

@@ -13,6 +13,7 @@
 #include "core/base/errors.hpp"
 #include "core/contact/contact_engine.hpp"
 #include "core/geometry/drum_geometry.hpp"
+#include "core/setup/size_law.hpp"
 #include "core/step/integrators.hpp"
 
 namespace dem2d {
@@ -49,10 +50,8 @@ std::string error_at(const Scene& scene, const std::string& key, const std::stri
 double expected_fill_count(const Scene& scene, std::size_t fill) {
   const FillSpec& s = scene.fills[fill];
   if (s.count > 0) return static_cast<double>(s.count);
-  const double a = s.radius_min, b = s.radius_max;
-  const double mean_area = std::numbers::pi * (a * a + a * b + b * b) / 3.0;
-  const double target = s.fill_fraction * std::numbers::pi * scene.drum.radius * scene.drum.radius;
-  return mean_area > 0.0 ? std::ceil(target / mean_area) : 0.0;
+  const double mean_area = mean_particle_area(s);
+  return mean_area > 0.0 ? std::ceil(fill_target_area(scene, s) / mean_area) : 0.0;
 }
 
 double fill_lattice_sites(const Scene& scene, std::size_t fill) {
@@ -99,20 +98,24 @@ double physical_memory_bytes() {
 
 namespace {
 
-// The key that sets how many particles fill f places (count or fill_fraction), and its value.
+// The key that sets how many particles fill f places (count, fill_fraction or bed_filling),
+// and its value.
 std::string count_key(const Scene& scene, std::size_t f) {
   const FillSpec& s = scene.fills[f];
   const std::string fill = "fill[" + std::to_string(s.index) + "]";
-  return s.count > 0 ? fill + ".count" : fill + ".fill_fraction";
+  if (s.count > 0) return fill + ".count";
+  return s.bed_filling > 0.0 ? fill + ".bed_filling" : fill + ".fill_fraction";
 }
 
 std::string count_text(const FillSpec& s) {
-  return s.count > 0 ? std::to_string(s.count) : num(s.fill_fraction);
+  if (s.count > 0) return std::to_string(s.count);
+  return num(s.bed_filling > 0.0 ? s.bed_filling : s.fill_fraction);
 }
 
-// The fill's radius key: radius, or radius_max of a range.
+// The fill's radius key: radius, radius_max of a range, or a table's sizes.
 std::string radius_key(const Scene& scene, const FillSpec& s) {
   const std::string fill = "fill[" + std::to_string(s.index) + "]";
+  if (scene.where.contains(fill + ".sizes")) return fill + ".sizes";  // a table: its largest
   return scene.where.contains(fill + ".radius_max") ? fill + ".radius_max" : fill + ".radius";
 }
 

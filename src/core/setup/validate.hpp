@@ -29,9 +29,9 @@ inline constexpr double kMaxRunSteps = 1.0e12;
 // plane, each pair listed once, and the skin and unequal radii add some.
 inline constexpr double kPairsPerParticle = 4.0;
 
-// The particles a fill places: its count, or, for a fill_fraction, the target area over the
-// mean area pi E[r^2] of its radius law (uniform in [a, b]: E[r^2] = (a^2 + ab + b^2) / 3),
-// without drawing the radii one by one as fill_count does.
+// The particles a fill places: its count, or, for a fill_fraction or bed_filling, the target
+// area over the mean area pi E[r^2] of its radius law (uniform in [a, b]: E[r^2] = (a^2 + ab +
+// b^2) / 3; size_law.hpp's mean_particle_area), without drawing the radii as fill_count does.
 double expected_fill_count(const Scene& scene, std::size_t fill);
 
 // The sites of the lattice a fill lays over its region to place its particles (spacing 2.1
