@@ -166,7 +166,8 @@ def plot_charge_shape(run, path):
         if column in s:
             ax.plot(t, s[column], color=color, linewidth=0.8, label=name)
     ax.set_ylabel("angle from the downward vertical [deg]\n(positive: drum's sense of rotation)")
-    ax.set_title(f"{run.title}\ncharge shape")
+    ax.set_title(f"{run.title}\ncharge shape (toe and shoulder: the shell layer's occupancy "
+                 "averaged over the analysis window)")
     handles = regime_bands(ax, s, with_legend=False)
     lines = ax.get_legend_handles_labels()[0]
     ax.legend(handles=lines + handles, loc="upper left", fontsize="small", ncol=2)

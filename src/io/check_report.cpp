@@ -47,7 +47,8 @@ std::string mill_check_lines(const Scene& s, const MillNumbers& m) {
          fmt_double(" = %.3f of critical", m.speed_fraction) +
          fmt_double(" (Froude number %.4f)\n", m.froude);
   out += fmt_double("  2D to 3D:              the slice is %.4g m thick", m.slice_thickness) +
-         " (the largest ball's diameter); a mill L m long draws about L / " +
+         " (the charge's mass-weighted mean diameter, sum(m d) / sum(m)); a mill L m long "
+         "draws about L / " +
          fmt_double("%.4g times its power\n", m.slice_thickness);
   return out;
 }
@@ -126,12 +127,7 @@ std::string check_report(const Simulation& sim, const Trial& trial) {
   std::string out = "dem2d --check " + s.deck_path + ": the deck is valid\n";
   if (!s.title.empty()) out += "  title:                 " + s.title + "\n";
   out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
-  double area = 0.0, r_max = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) {
-    area += std::numbers::pi * p.radius[k] * p.radius[k];
-    r_max = std::max(r_max, p.radius[k]);
-  }
-  if (s.drum.present) out += mill_check_lines(s, mill_numbers(s, area, r_max));
+  if (s.drum.present) out += mill_check_lines(s, mill_numbers(s, charge_sizes(p, Domain{})));
   if (s.breakage.present) out += breakage_line(s, p);
   out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +

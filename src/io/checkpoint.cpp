@@ -80,15 +80,23 @@ std::vector<std::pair<const char*, double*>> share_slots(RunState& s) {
 }
 
 // The mill analytics (/analysis): the window's samples, 8 values each (every rank holds the
-// same), and the collision spectra summed over ranks (collective).
+// same) and their shell layers (/analysis/shell: the bits packed little-endian into
+// kShellWords 64-bit words a sample), and the collision spectra summed over ranks (collective).
 constexpr std::size_t kSampleValues = 8;
+constexpr std::size_t kShellWords = (std::tuple_size_v<ShellBits> + 7) / 8;
 void write_analysis(h5::ParallelFile& file, const RunState& s) {
   file.create_group("/analysis");
   std::vector<double> window;
-  for (const MillSample& m : s.mill_samples)
+  std::vector<std::int64_t> shell(kShellWords * s.mill_samples.size(), 0);
+  for (std::size_t k = 0; k < s.mill_samples.size(); ++k) {
+    const MillSample& m = s.mill_samples[k];
     window.insert(window.end(), {m.time, m.drum_work, m.airborne, m.corotating, m.surface_angle,
                                  m.toe, m.shoulder, m.charge_angle});
+    for (std::size_t b = 0; b < m.shell.size(); ++b)
+      shell[k * kShellWords + b / 8] |= static_cast<std::int64_t>(m.shell[b]) << (8 * (b % 8));
+  }
   file.write_rows("/analysis/window", h5::rank0_rows(file.comm(), window.size()), window.data());
+  file.write_rows("/analysis/shell", h5::rank0_rows(file.comm(), shell.size()), shell.data());
   std::vector<std::int64_t> counts = s.spectra_counts;
   std::vector<double> energies = s.spectra_energies;
   mpi::sum_in_place(file.comm(), std::span<std::int64_t>(counts));
@@ -270,6 +278,14 @@ void read_analysis(const Reader& in, RunState& s) {
     const double* v = window.data() + k;
     s.mill_samples.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
   }
+  std::vector<std::int64_t> shell(in.shape("/analysis/shell")[0]);
+  if (shell.size() != kShellWords * s.mill_samples.size())
+    in.fail("/analysis/shell has the wrong length");
+  if (!shell.empty()) in.read("/analysis/shell", H5T_NATIVE_INT64, shell.data());
+  for (std::size_t k = 0; k < s.mill_samples.size(); ++k)
+    for (std::size_t b = 0; b < s.mill_samples[k].shell.size(); ++b)
+      s.mill_samples[k].shell[b] =
+          static_cast<std::uint8_t>(shell[k * kShellWords + b / 8] >> (8 * (b % 8)));
   s.spectra_counts.resize(in.shape("/analysis/spectra_counts")[0]);
   s.spectra_energies.resize(in.shape("/analysis/spectra_energies")[0]);
   if (!s.spectra_counts.empty())

@@ -14,13 +14,7 @@ namespace {
 // Collective: run.json's "mill" object: the mill's numbers, and the averages and regime over
 // the last analysis window.
 JsonObject mill_json(const Simulation& sim, const MpiDomain& domain) {
-  const ParticleStore& p = sim.particles();
-  double area = 0.0, r_max = 0.0;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) {
-    area += std::numbers::pi * p.radius[k] * p.radius[k];
-    r_max = std::max(r_max, p.radius[k]);
-  }
-  const MillNumbers m = mill_numbers(sim.scene(), domain.sum(area), domain.max(r_max));
+  const MillNumbers m = mill_numbers(sim.scene(), charge_sizes(sim.particles(), domain));
   const WindowSummary w = sim.mill_summary();
   const std::pair<const char*, double> items[] = {
       {"critical_speed_rad_s", m.critical_speed},
@@ -39,6 +33,7 @@ JsonObject mill_json(const Simulation& sim, const MpiDomain& domain) {
       {"corotating_fraction", w.corotating},
       {"toe_angle_deg", w.toe},
       {"shoulder_angle_deg", w.shoulder},
+      {"shell_arc_deg", w.shell_arc},
       {"surface_angle_deg", w.surface_angle},
       {"charge_angle_deg", w.charge_angle},
       {"charge_angle_std_deg", w.charge_angle_std}};

@@ -105,14 +105,20 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
      "is younger than the window)"},
     {"toe_angle", "deg", &SeriesRow::toe_angle, SeriesOnly::kDrum,
      "drum scenes: where the charge meets the shell, from the downward vertical, positive in "
-     "the drum's sense of rotation (docs/models.md, \"Mill analytics\"); `nan` when the "
-     "particles line the whole shell"},
+     "the drum's sense of rotation: where the shell layer's occupancy, time-averaged over the "
+     "last `output.analysis_window` seconds of rows (this row included), rises through half "
+     "its largest value (docs/models.md, \"Mill analytics\"); `nan` when the particles line "
+     "the whole shell"},
     {"shoulder_angle", "deg", &SeriesRow::shoulder_angle, SeriesOnly::kDrum,
-     "drum scenes: where the charge leaves the shell, same convention"},
+     "drum scenes: where the charge leaves the shell: where that occupancy falls through half "
+     "its largest value, same convention (`toe_angle` + `shell_arc`: above 180 when the "
+     "charge is carried past the top)"},
     {"surface_angle", "deg", &SeriesRow::surface_angle, SeriesOnly::kDrum,
-     "drum scenes: the bed's free surface from the horizontal, rising towards the shoulder"},
+     "drum scenes: the bed's free surface now from the horizontal, rising towards the "
+     "shoulder, across the chord between `toe_angle` and `shoulder_angle`"},
     {"shell_arc", "deg", &SeriesRow::shell_arc, SeriesOnly::kDrum,
-     "drum scenes: the arc of shell the charge covers (360: all of it)"},
+     "drum scenes: the arc from `toe_angle` to `shoulder_angle` (360: the charge lines all of "
+     "the shell)"},
     {"com_x", "m", &SeriesRow::com_x, SeriesOnly::kDrum,
      "drum scenes: the charge's centre of mass from the drum centre, horizontal"},
     {"com_y", "m", &SeriesRow::com_y, SeriesOnly::kDrum, "drum scenes: the same, vertical"},

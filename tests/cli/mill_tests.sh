@@ -8,6 +8,8 @@
 #   - --check prints the critical speeds, the fraction of critical, the bed filling J (and the
 #     fill that asked it) and the
 #     2D-to-3D slice thickness; run.json's "mill" object holds them with the regime;
+#   - the shell profile's toe and shoulder are the same on 1 and 3 ranks, and land where the
+#     pictures of a cataracting mill with lifters put them;
 #   - the collision spectra (collisions.csv) count the same contacts on 1 and 3 ranks, and a
 #     run resumed from a checkpoint on another rank count ends with the same spectra.
 #
@@ -47,7 +49,8 @@ expect "two speeds on 2 ranks" 2 'give only one of speed, speed_rpm and critical
 # (1 - 0.384)^(-1/4) sqrt(9.81 / 2.5) = 2.2360 rad/s, slice 0.2 m.
 expect "check bed filling" 0 'bed filling J: +0\.457' -- "$dem2d" --check "$wf"
 expect "check T37" 0 'with fill \(thesis T37\) 2\.2360 rad/s' -- "$dem2d" --check "$wf"
-expect "check slice" 0 '2D to 3D: +the slice is 0\.2 m thick' -- "$dem2d" --check "$wf"
+expect "check slice" 0 "2D to 3D: +the slice is 0\\.2 m thick \\(the charge's mass-weighted mean diameter" -- \
+  "$dem2d" --check "$wf"
 
 # --check names what sets dt, estimates the wall time from a trial, and says when ore breaks
 # while the fill still falls.
@@ -97,6 +100,23 @@ EOF
   ); then pass "$1: $out"; else fail "$1: $out"; fi
 }
 same_spectra "spectra on 1 and 3 ranks" "$tmp/np1" "$tmp/np3"
+
+# The shell profile's toe, shoulder and arc (series.csv, run.json) are integer sums over ranks:
+# the same on 1 and 3 ranks, digit for digit.
+if out=$("$py" - "$tmp/np1" "$tmp/np3" 2>&1 <<'EOF'
+import csv, json, sys
+rows = [list(csv.DictReader(open(f + "/series.csv"))) for f in sys.argv[1:]]
+assert len(rows[0]) == len(rows[1]) > 100, [len(r) for r in rows]
+for a, b in zip(*rows):
+    for k in ("toe_angle", "shoulder_angle", "shell_arc"):
+        assert a[k] == b[k], f"t = {a['time']}: {k} {a[k]} vs {b[k]}"
+mills = [json.load(open(f + "/run.json"))["mill"] for f in sys.argv[1:]]
+for k in ("toe_angle_deg", "shoulder_angle_deg", "shell_arc_deg"):
+    assert mills[0][k] == mills[1][k], f"{k}: {mills[0][k]} vs {mills[1][k]}"
+print(f"{len(rows[0])} rows, window toe {mills[0]['toe_angle_deg']:.1f}, shoulder "
+      f"{mills[0]['shoulder_angle_deg']:.1f}")
+EOF
+); then pass "shell profile on 1 and 3 ranks: $out"; else fail "shell profile on 1 and 3 ranks: $out"; fi
 same_spectra "spectra resumed 1 -> 2" "$tmp/np1" "$tmp/rs"
 
 # run.json's mill object: the numbers of --check and a regime over the window.
@@ -174,6 +194,25 @@ expect "sizes and mix: np3 snapshots identical to np1" 0 'bit-identical' -- "$py
   "$tmp/sz1/snapshots.h5" "$tmp/sz3/snapshots.h5"
 expect "sizes: --check asks the bed filling" 0 'asked: fill\[0\]\.bed_filling = 0\.15\)$' -- \
   "$dem2d" --check "$tmp/sizes.in"
+
+# The charge shape of a cataracting mill with lifters: 630 balls of 0.1 m (J = 0.3) at 0.75 of
+# critical in the waterfall's drum with its 24 lifters. Pictures put the toe at about -38 deg;
+# balls ride the lifters past 150 deg (a single moment's covered arc breaks at the gaps between
+# lifters: its toe jumps between -30 and +75 deg). The window's profile over 3-5 s: toe -44,
+# shoulder 165 (measured); windows ending at 4-6 s give toes from -37.6 to -45.8, and a layer
+# half a diameter thick instead of one moves the toe by 5 deg: 10 deg of tolerance.
+shape=(--quiet --set fill.0.fill_fraction=0.252 --set fill.0.radius=0.05 --set drum.critical_fraction=0.75
+  --set run.duration=5 --set output.analysis_window=2 --set output.snapshot_interval=5)
+"$dem2d" "$wf" "${shape[@]}" --output "$tmp/shape" > "$tmp/shape.log" 2>&1 || fail "shape run: $(cat "$tmp/shape.log")"
+if out=$("$py" - "$tmp/shape/run.json" 2>&1 <<'EOF'
+import json, sys
+m = json.load(open(sys.argv[1]))["mill"]
+assert abs(m["toe_angle_deg"] + 38.0) <= 10.0, m["toe_angle_deg"]
+assert m["shoulder_angle_deg"] > 100.0, m["shoulder_angle_deg"]
+assert m["regime"] == "cataracting", m["regime"]
+print(f"toe {m['toe_angle_deg']:.1f}, shoulder {m['shoulder_angle_deg']:.1f} deg")
+EOF
+); then pass "charge shape with lifters: $out"; else fail "charge shape with lifters: $out"; fi
 
 if [ "$failures" -gt 0 ]; then
   echo "$failures mill test(s) failed"

@@ -128,6 +128,117 @@ TEST(ChargeShape, BallsOnALifterRideTheShell) {
   }
 }
 
+// A row of balls on the shell from `from` to `to` (deg, centres), spaced one diameter apart
+// along the shell, leaving out those whose centres lie within `gap` (deg) of a lifter at
+// lifter0 + k * spacing; the shell layer of that moment.
+ShellBits shell_row(double from, double to, double lifter0 = 0.0, double spacing = 0.0,
+                    double gap = 0.0) {
+  ParticleStore p;
+  const double rho = kR - kBall, step = 2 * std::asin(kBall / rho) / kDeg;
+  for (double phi = from; phi <= to + 1e-9; phi += step) {
+    const double off = spacing > 0 ? std::remainder(phi - lifter0, spacing) : 1e9;
+    if (std::abs(off) < gap) continue;
+    add_ball(p, {rho * std::sin(phi * kDeg), -rho * std::cos(phi * kDeg)});
+  }
+  const DrumSpec d = circle_drum();
+  return measure_charge(p, walls_of(d), d, Domain{}, 0.0, kGravity).shell;
+}
+
+// The time-averaged profile of a row from -38 to 137 degrees (Morrell's toe and shoulder of
+// the defect's case) recovers its ends to the bin width, and so does a bare count profile.
+TEST(ShellProfile, ToeAndShoulderOfAKnownArc) {
+  const double rho = kR - kBall, half = std::asin(kBall / rho) / kDeg;
+  MillWindow w(1.0);
+  const ShellBits row = shell_row(-38.0 + half, 137.0);
+  for (int k = 0; k < 10; ++k) {
+    MillSample s;
+    s.time = 0.1 * k;
+    s.shell = row;
+    w.add(s);
+  }
+  const double last = -38.0 + half + 2 * half * std::floor((175.0 - half) / (2 * half));
+  EXPECT_NEAR(w.arc().toe, -38.0, 0.5);
+  EXPECT_NEAR(w.arc().shoulder, last + half, 0.5);
+  EXPECT_EQ(w.summary().toe, w.arc().toe);
+  // Counts 10 over [-38, 137), 3 beyond: the level is 5, crossed at the bins' edges.
+  std::vector<std::int64_t> counts(kShellBins, 3);
+  for (int b = (180 - 38) * 2; b < (180 + 137) * 2; ++b) counts[static_cast<std::size_t>(b)] = 10;
+  const ShellArc a = shell_arc(counts);
+  EXPECT_NEAR(a.toe, -38.0, 0.25);
+  EXPECT_NEAR(a.shoulder, 137.0, 0.25);
+  EXPECT_NEAR(a.arc, 175.0, 0.5);
+  counts.assign(kShellBins, 0);
+  EXPECT_EQ(shell_arc(counts).arc, 0.0);
+  EXPECT_TRUE(std::isnan(shell_arc(counts).toe));
+  counts.assign(kShellBins, 2);
+  EXPECT_EQ(shell_arc(counts).arc, 360.0);
+  EXPECT_TRUE(std::isnan(shell_arc(counts).shoulder));
+}
+
+// Lifters every 15 degrees turning with the drum leave a ball-sized gap in the layer at each:
+// every moment's covered arc breaks at them, the window's profile is one arc from end to end.
+TEST(ShellProfile, GapsAtLiftersStillMakeOneArc) {
+  const double rho = kR - kBall, half = std::asin(kBall / rho) / kDeg;
+  MillWindow w(10.0);
+  double widest_moment = 0.0;
+  for (int k = 0; k < 30; ++k) {  // the lifters move 1 degree a row: two lifter spacings
+    MillSample s;
+    s.time = 0.01 * k;
+    s.shell = shell_row(-40.0 + half, 100.0, 3.0 + k, 15.0, half);
+    std::vector<std::int64_t> moment(kShellBins);
+    for (int b = 0; b < kShellBins; ++b)
+      moment[static_cast<std::size_t>(b)] = shell_bit(s.shell, b);
+    widest_moment = std::max(widest_moment, shell_arc(moment).arc);
+    w.add(s);
+  }
+  EXPECT_LT(widest_moment, 30.0) << "each moment's arc ends at a gap";
+  const ShellArc a = w.arc();
+  EXPECT_NEAR(a.toe, -40.0, 1.0);
+  EXPECT_NEAR(a.shoulder, 100.0 + half, 2 * half);
+  // A window of one row is that row's own arc.
+  MillWindow one(0.005);
+  for (int k = 0; k < 2; ++k) {
+    MillSample s;
+    s.time = 0.01 * k;
+    s.shell = shell_row(-40.0 + half, 100.0, 3.0, 15.0, half);
+    one.add(s);
+  }
+  EXPECT_EQ(one.samples().size(), 1u);
+  EXPECT_LT(one.arc().arc, 30.0);
+}
+
+// The window's profile is the sum of the samples it holds: restoring them gives the same.
+TEST(ShellProfile, RestoredWindowHasTheSameProfile) {
+  MillWindow w(0.05);
+  for (int k = 0; k < 12; ++k) {
+    MillSample s;
+    s.time = 0.01 * k;
+    s.shell = shell_row(-30.0 + k, 60.0 + 2 * k);
+    w.add(s);
+  }
+  MillWindow r(0.05);
+  r.restore(w.samples());
+  EXPECT_EQ(r.profile(), w.profile());
+  EXPECT_EQ(w.samples().size(), 6u);
+  std::int64_t top = 0;
+  for (const std::int64_t c : w.profile()) top = std::max(top, c);
+  EXPECT_EQ(top, 6);
+}
+
+TEST(MillNumbers, SliceIsTheMassWeightedMeanDiameter) {
+  Scene s;
+  s.drum = circle_drum();
+  ParticleStore p;
+  add_ball(p, {0.0, -1.0});
+  add_ball(p, {0.5, -1.0});
+  EXPECT_EQ(mill_numbers(s, charge_sizes(p, Domain{})).slice_thickness, 2 * kBall);
+  // A ball of twice the diameter has 8 times the mass: (1 d + 1 d + 8 2d) / 10 = 1.8 d.
+  p.add(2, 0, 2 * kBall, 7800.0, {-0.5, -1.0}, {}, 0.0);
+  const ChargeSizes sizes = charge_sizes(p, Domain{});
+  EXPECT_EQ(sizes.d_max, 4 * kBall);
+  EXPECT_NEAR(mill_numbers(s, sizes).slice_thickness, 1.8 * 2 * kBall, 1e-12);
+}
+
 TEST(ChargeShape, ClockwiseDrumIsTheMirrorImage) {
   ParticleStore ccw, cw;
   ccw.enable_last_contact();

@@ -28,33 +28,22 @@ int bin_of(double angle_deg) {
 }
 double bin_centre(int b) { return (b + 0.5) * 360.0 / kShellBins - 180.0; }
 
-// The largest run of covered bins on the circle after bridging gaps of at most `bridge` bins:
-// its first bin and its length (0: nothing covered; kShellBins: all of it).
-std::pair<int, int> largest_arc(const std::vector<std::int64_t>& cover, int bridge) {
-  std::vector<char> on(kShellBins);
-  for (int b = 0; b < kShellBins; ++b) on[b] = cover[b] > 0;
-  // Bridge short gaps (circularly): a gap is a run of empty bins between two covered ones.
-  const int first = static_cast<int>(std::find(on.begin(), on.end(), 1) - on.begin());
-  if (first == kShellBins) return {0, 0};
-  std::vector<char> closed = on;
-  for (int k = 0, gap = 0; k <= kShellBins; ++k) {
-    const int b = (first + k) % kShellBins;
-    if (on[b] && k > 0) {
-      if (gap > 0 && gap <= bridge)
-        for (int g = 1; g <= gap; ++g) closed[(b - g + kShellBins) % kShellBins] = 1;
-      gap = 0;
-    } else if (!on[b]) {
-      ++gap;
-    }
-  }
-  if (std::all_of(closed.begin(), closed.end(), [](char c) { return c != 0; }))
-    return {0, kShellBins};
-  // Start the scan at an empty bin so that no run wraps past the scan's end.
-  const int empty = static_cast<int>(std::find(closed.begin(), closed.end(), 0) - closed.begin());
+constexpr double kBinWidth = 360.0 / kShellBins;  // deg
+
+// The longest run of bins with counts >= half the largest count, on the circle: its first bin
+// and its length (0: nothing covered; kShellBins: all of it). Ties: the first found from an
+// empty bin onwards.
+std::pair<int, int> main_run(std::span<const std::int64_t> counts, std::int64_t top) {
+  const auto in = [&](int b) { return 2 * counts[static_cast<std::size_t>(b)] >= top; };
+  if (top <= 0) return {0, 0};
+  int empty = 0;
+  while (empty < kShellBins && in(empty)) ++empty;
+  if (empty == kShellBins) return {0, kShellBins};
+  // Start the scan at a bin below the level so that no run wraps past the scan's end.
   int best_start = 0, best_len = 0;
   for (int k = 0, start = 0, len = 0; k < kShellBins; ++k) {
     const int b = (empty + k) % kShellBins;
-    if (!closed[b]) {
+    if (!in(b)) {
       len = 0;
       continue;
     }
@@ -79,10 +68,23 @@ struct Frame {
 struct ChargeSums {
   std::vector<std::int64_t> cover = std::vector<std::int64_t>(kShellBins + 3, 0);
   std::array<double, 3> moments{};  // m, m x, m y
-  double r_max = 0.0;
 };
 
-ChargeSums charge_sums(const ParticleStore& p, const Frame& f, double shell, double lift,
+// Adds the bins a particle at `d` (frame coordinates) of radius r covers.
+void cover_bins(std::vector<std::int64_t>& cover, Vec2 d, double r) {
+  const double rho = norm(d);
+  const double half = std::asin(std::min(1.0, r / rho)) * kDegree;
+  const double phi = Frame::angle(d);
+  const int b0 = bin_of(phi - half), n = static_cast<int>(std::ceil(2.0 * half / kBinWidth));
+  for (int b = 0; b <= n; ++b) {
+    const int bin = (b0 + b) % kShellBins;
+    if (std::abs(std::remainder(bin_centre(bin) - phi, 360.0)) <= half) ++cover[bin];
+  }
+}
+
+// layer: how far inside the lifters' tops (the shell without lifters) a particle's surface may
+// lie and still be next to the shell.
+ChargeSums charge_sums(const ParticleStore& p, const Frame& f, double shell, double layer,
                        double omega, double shell_speed, double time, Vec2 gravity) {
   const Field<double>* clock = p.last_contact();
   ChargeSums s;
@@ -92,7 +94,6 @@ ChargeSums charge_sums(const ParticleStore& p, const Frame& f, double shell, dou
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     const Vec2 d = f.local(p.pos[k]);
     const double r = p.radius[k], rho = norm(d);
-    s.r_max = std::max(s.r_max, r);
     s.moments[0] += p.mass[k];
     s.moments[1] += p.mass[k] * (p.pos[k].x - f.centre.x);
     s.moments[2] += p.mass[k] * (p.pos[k].y - f.centre.y);
@@ -100,16 +101,7 @@ ChargeSums charge_sums(const ParticleStore& p, const Frame& f, double shell, dou
     const Vec2 v_shell = omega * perp(p.pos[k] - f.centre);
     if (d.y > 0.0 && shell_speed > 0.0 && norm(p.vel[k] - v_shell) < 0.05 * shell_speed)
       ++corotating;
-    if (shell - rho - r >= r + lift || rho <= r) continue;  // not at the shell
-    if (!touching(p, k, gravity)) continue;                 // flying past it
-    const double half = std::asin(std::min(1.0, r / rho)) * kDegree;
-    const double phi = Frame::angle(d);
-    const int b0 = bin_of(phi - half),
-              n = static_cast<int>(std::ceil(2.0 * half * kShellBins / 360.0));
-    for (int b = 0; b <= n; ++b) {
-      const int bin = (b0 + b) % kShellBins;
-      if (std::abs(std::remainder(bin_centre(bin) - phi, 360.0)) <= half) ++s.cover[bin];
-    }
+    if (shell - rho - r < layer && rho > r) cover_bins(s.cover, d, r);
   }
   return s;
 }
@@ -163,17 +155,43 @@ void clock_contacts(ParticleStore& p, double time, Vec2 gravity) {
     if (touching(p, k, gravity)) (*clock)[k] = time;
 }
 
+ShellArc shell_arc(std::span<const std::int64_t> counts) {
+  const std::int64_t top = *std::max_element(counts.begin(), counts.end());
+  const auto [start, len] = main_run(counts, top);
+  ShellArc a;
+  if (len == 0 || len == kShellBins) {
+    a.toe = a.shoulder = kNaN;
+    a.arc = len * kBinWidth;
+    return a;
+  }
+  // The half level's crossings between the run's end bins and their outer neighbours' centres.
+  const double level = 0.5 * static_cast<double>(top);
+  const auto at = [&](int b) {
+    return static_cast<double>(counts[static_cast<std::size_t>((b + kShellBins) % kShellBins)]);
+  };
+  const int end = start + len - 1;
+  const double in_toe = (at(start) - level) / (at(start) - at(start - 1));
+  const double in_shoulder = (at(end) - level) / (at(end) - at(end + 1));
+  a.toe = bin_centre(start) - in_toe * kBinWidth;
+  a.arc = (len - 1 + in_toe + in_shoulder) * kBinWidth;
+  if (a.toe < -180.0) a.toe += 360.0;
+  a.shoulder = a.toe + a.arc;  // above 180: the charge is carried past the top
+  return a;
+}
+
 ChargeShape measure_charge(const ParticleStore& p, const Walls& walls, const DrumSpec& drum,
-                           const Domain& domain, double time, Vec2 gravity) {
+                           const Domain& domain, double time, Vec2 gravity, bool surface) {
   const double omega = walls.drum_omega();
   const Frame f{drum.center, drum.speed < 0.0 ? -1.0 : 1.0};
   const DrumGeometry geometry(drum);
   const double shell = geometry.inner_radius();
-  ChargeSums s = charge_sums(p, f, shell, geometry.tallest_lifter(), omega, std::abs(omega) * shell,
-                             time, gravity);
+  double r_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) r_max = std::max(r_max, p.radius[k]);
+  r_max = domain.max(r_max);
+  ChargeSums s = charge_sums(p, f, shell, geometry.tallest_lifter() + 2.0 * r_max, omega,
+                             std::abs(omega) * shell, time, gravity);
   domain.sum(std::span<std::int64_t>(s.cover));
   domain.sum(std::span<double>(s.moments));
-  const double r_max = domain.max(s.r_max);
   ChargeShape c;
   const double n = static_cast<double>(std::max<std::int64_t>(1, s.cover[kShellBins + 2]));
   c.airborne_fraction = static_cast<double>(s.cover[kShellBins]) / n;
@@ -181,25 +199,29 @@ ChargeShape measure_charge(const ParticleStore& p, const Walls& walls, const Dru
   c.mass = s.moments[0];
   c.com_x = s.moments[0] > 0 ? s.moments[1] / s.moments[0] : kNaN;
   c.com_y = s.moments[0] > 0 ? s.moments[2] / s.moments[0] : kNaN;
-  const int bridge =
-      static_cast<int>(std::ceil(2.0 * r_max / shell * kDegree * kShellBins / 360.0));
-  const auto [start, len] = largest_arc(s.cover, bridge);
-  c.shell_arc = len * 360.0 / kShellBins;
-  if (len == 0 || len == kShellBins) {
-    c.toe = c.shoulder = c.surface_angle = kNaN;
-    return c;
+  std::vector<std::int64_t> on(kShellBins);
+  for (int b = 0; b < kShellBins; ++b) {
+    on[static_cast<std::size_t>(b)] = s.cover[static_cast<std::size_t>(b)] > 0;
+    if (on[static_cast<std::size_t>(b)]) c.shell[b / 8] |= static_cast<std::uint8_t>(1 << (b % 8));
   }
-  c.toe = bin_centre(start) - 0.5 * 360.0 / kShellBins;
-  c.shoulder = c.toe + c.shell_arc;
-  if (c.shoulder > 180.0) {  // the arc runs past the top: keep toe < shoulder, toe in range
-    c.toe -= 360.0;
-    c.shoulder -= 360.0;
-  }
-  // A charge spread over more than three quarters of the shell has no free surface to speak of.
-  c.surface_angle = c.shell_arc > 270.0
-                        ? kNaN
-                        : surface_angle(p, f, domain, shell, c.toe, c.shoulder, r_max, gravity);
+  const ShellArc a = shell_arc(on);
+  c.toe = a.toe;
+  c.shoulder = a.shoulder;
+  c.shell_arc = a.arc;
+  c.surface_angle = kNaN;
+  if (surface) c.surface_angle = measure_surface_angle(p, drum, domain, c.toe, c.shoulder, gravity);
   return c;
+}
+
+double measure_surface_angle(const ParticleStore& p, const DrumSpec& drum, const Domain& domain,
+                             double toe, double shoulder, Vec2 gravity) {
+  // A charge spread over more than three quarters of the shell has no free surface to speak of.
+  if (!std::isfinite(toe) || !std::isfinite(shoulder) || shoulder - toe > 270.0) return kNaN;
+  const Frame f{drum.center, drum.speed < 0.0 ? -1.0 : 1.0};
+  double r_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) r_max = std::max(r_max, p.radius[k]);
+  return surface_angle(p, f, domain, DrumGeometry(drum).inner_radius(), toe, shoulder,
+                       domain.max(r_max), gravity);
 }
 
 const char* regime_name(Regime r) {
@@ -220,12 +242,32 @@ Regime classify(const WindowSummary& w, const RegimeThresholds& t) {
   return Regime::kRolling;
 }
 
+void MillWindow::count(const ShellBits& bits, int sign) {
+  for (int b = 0; b < kShellBins; ++b)
+    if (shell_bit(bits, b)) counts_[static_cast<std::size_t>(b)] += sign;
+}
+
 void MillWindow::add(const MillSample& s) {
   samples_.push_back(s);
+  count(s.shell, +1);
   const auto old = std::find_if(samples_.begin(), samples_.end(), [&](const MillSample& m) {
     return m.time >= s.time - window_ * (1.0 + 1e-9);
   });
+  for (auto it = samples_.begin(); it != old; ++it) count(it->shell, -1);
   samples_.erase(samples_.begin(), old);
+}
+
+void MillWindow::set_last_shape(double toe, double shoulder, double surface_angle) {
+  if (samples_.empty()) return;
+  samples_.back().toe = toe;
+  samples_.back().shoulder = shoulder;
+  samples_.back().surface_angle = surface_angle;
+}
+
+void MillWindow::restore(std::vector<MillSample> samples) {
+  samples_ = std::move(samples);
+  std::fill(counts_.begin(), counts_.end(), 0);
+  for (const MillSample& s : samples_) count(s.shell, +1);
 }
 
 WindowSummary MillWindow::summary() const {
@@ -240,10 +282,8 @@ WindowSummary MillWindow::summary() const {
     w.corotating += s.corotating;
     w.charge_angle += s.charge_angle;
     angle2 += s.charge_angle * s.charge_angle;
-    if (std::isfinite(s.surface_angle) && std::isfinite(s.toe)) {
+    if (std::isfinite(s.surface_angle)) {
       w.surface_angle += s.surface_angle;
-      w.toe += s.toe;
-      w.shoulder += s.shoulder;
       ++n;
     }
   }
@@ -252,13 +292,11 @@ WindowSummary MillWindow::summary() const {
   w.corotating /= m;
   w.charge_angle /= m;
   w.charge_angle_std = std::sqrt(std::max(0.0, angle2 / m - w.charge_angle * w.charge_angle));
-  if (n > 0) {
-    w.surface_angle /= n;
-    w.toe /= n;
-    w.shoulder /= n;
-  } else {
-    w.surface_angle = w.toe = w.shoulder = kNaN;
-  }
+  w.surface_angle = n > 0 ? w.surface_angle / n : kNaN;
+  const ShellArc profile = arc();
+  w.toe = profile.toe;
+  w.shoulder = profile.shoulder;
+  w.shell_arc = profile.arc;
   // Full once samples older than the window were dropped (row times need not fall on a grid
   // of the window: dt = "auto"), or when they span it. Runs start at t = 0.
   if (a.time > 0.0 || w.span >= window_ * (1.0 - 1e-9)) w.regime = classify(w);
@@ -354,12 +392,34 @@ double critical_speed_with_fill(double gravity, double radius, double phi) {
 
 double bed_filling(double phi) { return phi / kBedPacking; }
 
-MillNumbers mill_numbers(const Scene& scene, double particle_area, double largest_radius) {
+double ChargeSizes::slice_thickness() const {
+  if (d_min == d_max || !(mass > 0.0)) return d_max;
+  return mass_diameter / mass;
+}
+
+ChargeSizes charge_sizes(const ParticleStore& p, const Domain& domain) {
+  std::array<double, 3> sums{};  // area, mass, mass x diameter
+  double d_min = std::numeric_limits<double>::max(), d_max = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    const double r = p.radius[k];
+    sums[0] += std::numbers::pi * r * r;
+    sums[1] += p.mass[k];
+    sums[2] += p.mass[k] * 2.0 * r;
+    d_min = std::min(d_min, 2.0 * r);
+    d_max = std::max(d_max, 2.0 * r);
+  }
+  domain.sum(std::span<double>(sums));
+  ChargeSizes s{sums[0], sums[1], sums[2], -domain.max(-d_min), domain.max(d_max)};
+  if (s.d_min > s.d_max) s.d_min = s.d_max;  // no particle
+  return s;
+}
+
+MillNumbers mill_numbers(const Scene& scene, const ChargeSizes& sizes) {
   MillNumbers m;
-  m.slice_thickness = 2.0 * largest_radius;
+  m.slice_thickness = sizes.slice_thickness();
   if (!scene.drum.present) return m;
   const double g = norm(scene.run.gravity), R = scene.drum.radius;
-  m.fill_fraction = particle_area / (std::numbers::pi * R * R);
+  m.fill_fraction = sizes.area / (std::numbers::pi * R * R);
   m.bed_filling = bed_filling(m.fill_fraction);
   m.critical_speed = critical_speed(g, R);
   m.critical_speed_with_fill = critical_speed_with_fill(g, R, m.fill_fraction);

@@ -28,11 +28,35 @@
 
 namespace dem2d {
 
+// Angular resolution of the shell profile (the shell is cut into this many bins).
+inline constexpr int kShellBins = 720;  // 0.5 degree
+
+// The shell layer at one moment: bit b (byte b / 8, bit b % 8) set when a particle in contact
+// lying next to the shell covers bin b (bin 0 starts at -180 degrees).
+using ShellBits = std::array<std::uint8_t, kShellBins / 8>;
+inline bool shell_bit(const ShellBits& bits, int b) { return (bits[b / 8] >> (b % 8)) & 1; }
+
+// Where the charge meets the shell (toe) and leaves it (shoulder), from a profile of the shell
+// layer's occupancy (counts per bin out of some number of moments): the bins whose count is at
+// least half of the largest form runs; the longest run is the charge's main body, and toe and
+// shoulder are where the profile crosses that half level on either side of it (interpolated
+// linearly between bin centres). toe and shoulder NaN when the run is the whole circle (arc 360)
+// or nothing is covered (arc 0). toe in [-180, 180), shoulder = toe + arc: above 180 when the
+// charge is carried past the top.
+struct ShellArc {
+  double toe = 0.0, shoulder = 0.0, arc = 0.0;  // deg
+};
+ShellArc shell_arc(std::span<const std::int64_t> counts);
+
 struct ChargeShape {
-  // Where the charge meets the shell (toe) and leaves it (shoulder): the ends of the largest
-  // arc of the shell covered by particles in contact that touch it or lie within one radius of
-  // it, or of the tallest lifter's top (gaps narrower than one largest diameter bridged). NaN when
-  // the arc is the whole circle.
+  // The shell layer now: the particles whose surface lies within one largest diameter of the
+  // tallest lifter's top (of the shell without lifters), in contact or not (the balls landing
+  // at the toe and leaving the lifters at the shoulder are the charge's ends), each covering
+  // the bins its own angular width spans.
+  ShellBits shell{};
+  // Toe, shoulder and arc of this moment's layer alone (shell_arc of its bits: the largest
+  // covered arc, broken wherever a gap between lifters is empty now). The series and the
+  // window report the time-averaged profile's instead (MillWindow).
   double toe = 0.0, shoulder = 0.0;  // deg
   double shell_arc = 0.0;            // deg, 360 when the particles line the whole shell
   // The free surface: the angle from the horizontal of a straight line fitted to the highest
@@ -49,9 +73,6 @@ struct ChargeShape {
   double corotating_fraction = 0.0;
 };
 
-// Angular resolution of toe and shoulder (the shell is cut into this many bins).
-inline constexpr int kShellBins = 720;  // 0.5 degree
-
 // A ball thrown off the shoulder flies 0.2-0.8 s; hops in a dense bed last up to about 0.1 s
 // (tests/core/test_system.cpp measured both on the thesis scenes).
 inline constexpr double kFlightTime = 0.15;  // s
@@ -61,8 +82,13 @@ inline constexpr double kFlightTime = 0.15;  // s
 void clock_contacts(ParticleStore& p, double time, Vec2 gravity);
 
 // The charge of a scene with a drum at `time` (collective: every rank returns the same shape).
+// Without `surface` the surface angle is left NaN (measure_surface_angle gives it for a chord).
 ChargeShape measure_charge(const ParticleStore& p, const Walls& walls, const DrumSpec& drum,
-                           const Domain& domain, double time, Vec2 gravity);
+                           const Domain& domain, double time, Vec2 gravity, bool surface = true);
+// The free surface's angle (ChargeShape::surface_angle) across the chord from `toe` to
+// `shoulder` (collective; NaN when either is NaN or the arc exceeds 270 degrees).
+double measure_surface_angle(const ParticleStore& p, const DrumSpec& drum, const Domain& domain,
+                             double toe, double shoulder, Vec2 gravity);
 
 enum class Regime {
   kUnknown,
@@ -85,9 +111,9 @@ const char* regime_name(Regime r);
 //   slumping               the charge swings: the direction of its centre of mass varies with
 //                          a standard deviation above 2 degrees (avalanches, or the bed
 //                          rocking and sliding on the shell);
-//   cascading              the charge is carried above its free surface: the toe-shoulder
-//                          chord stands at least 5 degrees steeper than the surface (the
-//                          kidney shape);
+//   cascading              the charge is carried above its free surface: the chord between
+//                          the window's toe and shoulder stands at least 5 degrees steeper
+//                          than the surface (the kidney shape);
 //   rolling                a steady, flat surface.
 struct RegimeThresholds {
   double centrifuging_corotating = 0.15;
@@ -101,8 +127,11 @@ struct RegimeThresholds {
 struct MillSample {
   double time = 0.0;
   double drum_work = 0.0;  // J, the drum's drive work since the start (all ranks)
+  // toe and shoulder: the window's profile's at this row (MillWindow::arc after adding it);
+  // surface_angle across their chord.
   double airborne = 0.0, corotating = 0.0, surface_angle = 0.0, toe = 0.0, shoulder = 0.0;
   double charge_angle = 0.0;  // deg, the centre of mass's direction (same convention)
+  ShellBits shell{};          // the shell layer at this row (ChargeShape::shell)
 };
 
 // Averages over the window and the regime they give.
@@ -110,27 +139,41 @@ struct WindowSummary {
   double span = 0.0;   // s covered by the samples
   double power = 0.0;  // W: the drum's work over the span / span
   double airborne = 0.0, corotating = 0.0;
-  double surface_angle = 0.0, toe = 0.0, shoulder = 0.0;  // deg
-  double charge_angle = 0.0, charge_angle_std = 0.0;      // deg
+  double surface_angle = 0.0;  // deg, the rows' mean
+  // The time-averaged shell profile's toe, shoulder and covered arc (MillWindow::arc).
+  double toe = 0.0, shoulder = 0.0, shell_arc = 0.0;  // deg
+  double charge_angle = 0.0, charge_angle_std = 0.0;  // deg
   Regime regime = Regime::kUnknown;
 };
 
 Regime classify(const WindowSummary& w, const RegimeThresholds& t = {});
 
+// The samples of the last `window` seconds of rows, and the shell profile they make: per bin,
+// the number of samples whose shell layer covers it (exact integer sums, the same on any rank
+// count: each sample's bits are decided on the counts summed over ranks).
 class MillWindow {
  public:
-  explicit MillWindow(double window = 1.0) : window_(window) {}
+  explicit MillWindow(double window = 1.0)
+      : window_(window), counts_(static_cast<std::size_t>(kShellBins), 0) {}
   // Adds a sample (times increasing) and forgets those older than its time - window.
   void add(const MillSample& s);
+  // The newest sample's toe, shoulder and surface angle (measured from arc() after add()).
+  void set_last_shape(double toe, double shoulder, double surface_angle);
+  // The time-averaged profile's toe and shoulder over the samples held (shell_arc).
+  ShellArc arc() const { return shell_arc(counts_); }
   // The averages over the samples held; regime kUnknown until the run is a window old.
   WindowSummary summary() const;
   double window() const { return window_; }
   const std::vector<MillSample>& samples() const { return samples_; }
-  void restore(std::vector<MillSample> samples) { samples_ = std::move(samples); }
+  const std::vector<std::int64_t>& profile() const { return counts_; }
+  void restore(std::vector<MillSample> samples);
 
  private:
+  void count(const ShellBits& bits, int sign);
+
   double window_;
   std::vector<MillSample> samples_;
+  std::vector<std::int64_t> counts_;  // per shell bin
 };
 
 // What a contact touched.
@@ -201,12 +244,24 @@ struct MillNumbers {
   double froude = 0.0;                    // Omega^2 R / |g|
   double fill_fraction = 0.0;             // particle cross-sections / drum area
   double bed_filling = 0.0;               // J, the bed with its voids / drum area
-  // The 2D slice is one layer of spheres: its thickness is the largest diameter, and a mill L m
-  // long draws about L / slice_thickness times the slice's power (end walls neglected).
+  // The 2D slice is one layer of spheres: its thickness is the charge's mass-weighted mean
+  // diameter (ChargeSizes::slice_thickness), and a mill L m long draws about
+  // L / slice_thickness times the slice's power (end walls neglected).
   double slice_thickness = 0.0;  // m
 };
-// particle_area: sum of pi r^2 over every particle; largest_radius over every particle.
-MillNumbers mill_numbers(const Scene& scene, double particle_area, double largest_radius);
+
+// Sums over every particle of the charge (collective).
+struct ChargeSizes {
+  double area = 0.0;           // m^2, sum of pi r^2
+  double mass = 0.0;           // kg, sum of m
+  double mass_diameter = 0.0;  // kg m, sum of m d
+  double d_min = 0.0, d_max = 0.0;
+  // The mass-weighted mean diameter sum(m d) / sum(m): the diameter of the typical sphere the
+  // charge's mass sits in; exactly the diameter when all are alike (d_min == d_max).
+  double slice_thickness() const;
+};
+ChargeSizes charge_sizes(const ParticleStore& p, const Domain& domain);
+MillNumbers mill_numbers(const Scene& scene, const ChargeSizes& sizes);
 
 // The classical critical speed sqrt(|g| / R) and the thesis's with the fill (T37):
 // (1 - phi)^(-1/4) sqrt(|g| / R), phi the particles' share of the drum's cross-section.

@@ -569,19 +569,25 @@ SeriesRow Simulation::record_row() {
   if (!scene_.drum.present) return row;
   clock_contacts(particles_, time_, scene_.run.gravity);
   const ChargeShape c =
-      measure_charge(particles_, walls_, scene_.drum, *domain_, time_, scene_.run.gravity);
-  row.toe_angle = c.toe;
-  row.shoulder_angle = c.shoulder;
-  row.surface_angle = c.surface_angle;
-  row.shell_arc = c.shell_arc;
+      measure_charge(particles_, walls_, scene_.drum, *domain_, time_, scene_.run.gravity, false);
   row.com_x = c.com_x;
   row.com_y = c.com_y;
   row.airborne_fraction = c.airborne_fraction;
   row.corotating_fraction = c.corotating_fraction;
   const double sense = scene_.drum.speed < 0.0 ? -1.0 : 1.0;
-  mill_window_.add({row.time, row.drum_work, c.airborne_fraction, c.corotating_fraction,
-                    c.surface_angle, c.toe, c.shoulder,
-                    std::atan2(sense * c.com_x, -c.com_y) * 180.0 / std::numbers::pi});
+  MillSample sample{row.time, row.drum_work, c.airborne_fraction, c.corotating_fraction};
+  sample.charge_angle = std::atan2(sense * c.com_x, -c.com_y) * 180.0 / std::numbers::pi;
+  sample.shell = c.shell;
+  mill_window_.add(sample);
+  // Toe and shoulder of the window's time-averaged shell profile, this row included; the
+  // surface across their chord.
+  const ShellArc arc = mill_window_.arc();
+  row.toe_angle = arc.toe;
+  row.shoulder_angle = arc.shoulder;
+  row.shell_arc = arc.arc;
+  row.surface_angle = measure_surface_angle(particles_, scene_.drum, *domain_, arc.toe,
+                                            arc.shoulder, scene_.run.gravity);
+  mill_window_.set_last_shape(arc.toe, arc.shoulder, row.surface_angle);
   const WindowSummary w = mill_window_.summary();
   row.power_avg = w.span > 0.0 ? w.power : row.drum_power;
   row.regime = regime_name(w.regime);
