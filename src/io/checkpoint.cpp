@@ -270,6 +270,8 @@ std::vector<std::string> Reader::strings(const std::string& name) const {
   return out;
 }
 
+void read_spectra(const Reader& in, RunState& s);
+
 void read_analysis(const Reader& in, RunState& s) {
   std::vector<double> window(in.shape("/analysis/window")[0]);
   if (window.size() % kSampleValues != 0) in.fail("/analysis/window has the wrong length");
@@ -278,6 +280,10 @@ void read_analysis(const Reader& in, RunState& s) {
     const double* v = window.data() + k;
     s.mill_samples.push_back({v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]});
   }
+  // A checkpoint written before the window's shell profile existed has none: its samples keep
+  // their other values and an empty profile, which scales every bin alike, so the window's toe
+  // and shoulder come from the samples after the restart.
+  if (!in.has("/analysis/shell")) return read_spectra(in, s);
   std::vector<std::int64_t> shell(in.shape("/analysis/shell")[0]);
   if (shell.size() != kShellWords * s.mill_samples.size())
     in.fail("/analysis/shell has the wrong length");
@@ -286,6 +292,10 @@ void read_analysis(const Reader& in, RunState& s) {
     for (std::size_t b = 0; b < s.mill_samples[k].shell.size(); ++b)
       s.mill_samples[k].shell[b] =
           static_cast<std::uint8_t>(shell[k * kShellWords + b / 8] >> (8 * (b % 8)));
+  read_spectra(in, s);
+}
+
+void read_spectra(const Reader& in, RunState& s) {
   s.spectra_counts.resize(in.shape("/analysis/spectra_counts")[0]);
   s.spectra_energies.resize(in.shape("/analysis/spectra_energies")[0]);
   if (!s.spectra_counts.empty())

@@ -64,7 +64,7 @@ TEST(FillSizes, BedFillingPlacesTheAskedJWithinOneParticle) {
     ParticleStore p;
     place(s, p);
     const double drum_area = std::numbers::pi;
-    const MillNumbers m = mill_numbers(s, total_area(p), 0.03);
+    const MillNumbers m = mill_numbers(s, charge_sizes(p, Domain{}));
     EXPECT_GE(m.bed_filling, j);
     EXPECT_LT(m.bed_filling - j, std::numbers::pi * 0.03 * 0.03 / (kBedPacking * drum_area));
     EXPECT_EQ(static_cast<std::int64_t>(p.size()), fill_count(s, 0));
