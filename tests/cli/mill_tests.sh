@@ -65,6 +65,16 @@ expect "check breakage while the fill falls" 0 'breakage from: +t = 0 s \(breaka
   "$dem2d" --check --set breakage.start=0 "$gr"
 expect "check breakage after the fill" 0 'breakage from: +t = 1 s \(breakage\.start\)$' -- "$dem2d" --check "$gr"
 
+# An ore deck without a [sieve] says at its start that nothing leaves the mill, and run.json's
+# ore object says so.
+awk '/^\[sieve\]/ { skip = 1; next } /^\[/ { skip = 0 } !skip' "$gr" > "$tmp/nosieve.in"
+expect "ore deck without a sieve: told" 0 'nosieve\.in: note: no \[sieve\]: nothing leaves the mill, product\.csv keeps only its header' -- \
+  "$dem2d" "$tmp/nosieve.in" --quiet --set run.duration=0.002 --output "$tmp/nosieve"
+expect "ore deck without a sieve: run.json" 0 '^False 0$' -- "$py" -c "
+import json
+o = json.load(open('$tmp/nosieve/run.json'))['ore']
+print(o['sieve'], o['discharged_count'])"
+
 # A short run with spectra on 1 and 3 ranks, and one resumed 1 -> 2 from a checkpoint at 0.3 s.
 run=(--quiet --set run.duration=0.3 --set output.collision_spectra=true --set output.snapshot_interval=0.1
   --set output.analysis_window=0.2)
