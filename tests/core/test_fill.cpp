@@ -32,14 +32,7 @@ Scene drum_scene(int sides = 0) {
 }
 
 FillSpec fill(std::int64_t count, double r_min, double r_max, FillRegion region) {
-  FillSpec f;
-  f.material = "steel";
-  f.count = count;
-  f.radius_min = r_min;
-  f.radius_max = r_max;
-  f.region = region;
-  f.source_line = 7;
-  return f;
+  return testing_support::fill_spec("steel", count, r_min, r_max, region);
 }
 
 struct Placed {

@@ -28,14 +28,7 @@ Scene drum_scene(double radius) {
 
 FillSpec fill(const char* material, std::int64_t count, double r_min, double r_max,
               FillRegion region) {
-  FillSpec f;
-  f.material = material;
-  f.count = count;
-  f.radius_min = r_min;
-  f.radius_max = r_max;
-  f.region = region;
-  f.source_line = 7;
-  return f;
+  return testing_support::fill_spec(material, count, r_min, r_max, region);
 }
 
 // Places the scene's fills into `p` (empty) and checks no two overlap.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -59,6 +60,20 @@ inline ParticleSpec ball(const std::string& material, double r, Vec2 x, Vec2 v =
   p.velocity = v;
   p.spin = spin;
   return p;
+}
+
+// A [[fill]] of `count` particles of `material`, radii uniform in [r_min, r_max], in `region`,
+// at deck line 7 (for the messages tests read).
+inline FillSpec fill_spec(const std::string& material, std::int64_t count, double r_min,
+                          double r_max, FillRegion region) {
+  FillSpec f;
+  f.material = material;
+  f.count = count;
+  f.radius_min = r_min;
+  f.radius_max = r_max;
+  f.region = region;
+  f.source_line = 7;
+  return f;
 }
 
 inline WallSpec segment(Vec2 from, Vec2 to, const std::string& material, Vec2 velocity = {}) {
