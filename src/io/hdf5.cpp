@@ -111,13 +111,9 @@ namespace {
 PropListHandle mpio_access(MPI_Comm comm) {
   PropListHandle fapl(H5Pcreate(H5P_FILE_ACCESS));
   if (!fapl.valid()) return fapl;
-  MPI_Info info = MPI_INFO_NULL;
-  MPI_Info_create(&info);
-  MPI_Info_set(info, "romio_ds_write", "disable");
-  MPI_Info_set(info, "romio_ds_read", "disable");
-  const bool ok = H5Pset_fapl_mpio(fapl.get(), comm, info) >= 0 &&
+  const mpi::IoHints hints;  // the property list keeps its own copy
+  const bool ok = H5Pset_fapl_mpio(fapl.get(), comm, hints.get()) >= 0 &&
                   H5Pset_coll_metadata_write(fapl.get(), true) >= 0;
-  MPI_Info_free(&info);  // the property list holds its own copy
   return ok ? std::move(fapl) : PropListHandle();
 }
 

@@ -37,6 +37,21 @@ int size(MPI_Comm comm);
 // Not collective: seconds of wall time since some fixed point (MPI_Wtime).
 double wall_time();
 
+// Not collective: MPI-IO hints for the files HDF5 writes (an MPI_Info the holder frees). ROMIO's
+// data sieving is off: the small pieces of an HDF5 file's metadata are written as they are, not
+// as a read-modify-write of a 512 KiB window around them.
+class IoHints {
+ public:
+  IoHints();
+  ~IoHints();
+  IoHints(const IoHints&) = delete;
+  IoHints& operator=(const IoHints&) = delete;
+  MPI_Info get() const { return info_; }
+
+ private:
+  MPI_Info info_ = MPI_INFO_NULL;
+};
+
 // Sums of integers (exact in any order).
 std::int64_t sum(MPI_Comm comm, std::int64_t x);
 std::uint64_t sum(MPI_Comm comm, std::uint64_t x);

@@ -163,6 +163,7 @@ status is the number of failures."""
 import contextlib
 import importlib.util
 import io
+import os
 import json
 import re
 import sys
@@ -305,6 +306,9 @@ def runjson(path, key, expected):
 
 def compare(first, second):
     """post/h5compare.py FIRST SECOND --by-step --allow-added."""
+    post = os.path.dirname(os.path.abspath(sys.argv[2]))
+    if post not in sys.path:  # h5compare imports its neighbours in post/
+        sys.path.insert(0, post)
     spec = importlib.util.spec_from_file_location("h5compare", sys.argv[2])
     h5compare = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(h5compare)
