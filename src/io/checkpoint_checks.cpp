@@ -142,16 +142,19 @@ std::string containment_problem(const Scene& scene, const Columns& c, double tim
     const double r = c.real(radius, k);
     const Vec2 at_start = d.center + rotate(x - d.center, -turned);
     const double overlap = r - drum.shell_clearance(at_start);
-    const std::string particle = fmt::format(
-        "/particles/position: particle {} (radius {:g} m) at [{:g}, {:g}]", c.id(k), r, x.x, x.y);
-    if (overlap >= r + r) return fmt::format("{} lies outside {}", particle, where);
+    // Formatted only for the particle at fault: the loop runs over every particle.
+    const auto particle = [&] {
+      return fmt::format("/particles/position: particle {} (radius {:g} m) at [{:g}, {:g}]",
+                         c.id(k), r, x.x, x.y);
+    };
+    if (overlap >= r + r) return fmt::format("{} lies outside {}", particle(), where);
     if (overlap > tolerance * r)
       return fmt::format(
           "{} overlaps the shell of {} by {:.3g} % of its radius; at most {:g} % "
           "is allowed",
-          particle, where, 100.0 * overlap / r, 100.0 * tolerance);
+          particle(), where, 100.0 * overlap / r, 100.0 * tolerance);
     if (const auto bar = drum.bar_overlap(at_start, r - tolerance * r))
-      return fmt::format("{} {} bar {} of drum.lifter[{}] at t = {:g} s", particle,
+      return fmt::format("{} {} bar {} of drum.lifter[{}] at t = {:g} s", particle(),
                          bar->inside ? "lies inside" : "overlaps", bar->bar, bar->lifter, time);
   }
   return {};
