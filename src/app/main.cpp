@@ -23,6 +23,7 @@
 #include "io/checkpoint.hpp"
 #include "io/console.hpp"
 #include "io/deck.hpp"
+#include "io/grinding_report.hpp"
 #include "io/output_dir.hpp"
 #include "io/run_info.hpp"
 #include "io/run_json.hpp"
@@ -183,6 +184,16 @@ int run(const Options& opt) {
       {n_global, loop.particles(), loop.particle_steps(), wall, sim.step_count() - first_step,
        ending == Ending::kInterrupted, opt.restart, opt.sets});
   if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
+  if (is_ore_scene(scene)) {
+    const GrindingReport sizes = grinding_report(sim, domain);
+    std::string error;
+    try {
+      if (g_rank == 0) write_sizes_csv(out.directory, sizes);
+    } catch (const IoError& e) {
+      error = e.what();
+    }
+    mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+  }
   if (!opt.quiet && ending == Ending::kFinished)
     say(fmt_double("done: %.4g s simulated", sim.time()) +
         fmt_double(" in %.3g s of wall time", wall) +

@@ -107,6 +107,29 @@ void write_analysis(h5::ParallelFile& file, const RunState& s) {
                   energies.data());
 }
 
+// The ore's size distributions (/grinding/sizes: initial, fed, product, SizeMasses::kClasses
+// integers each, the product summed over ranks; collective) and the fines' mass.
+constexpr std::size_t kSizeRows = 3 * SizeMasses::kClasses;
+void write_sizes(h5::ParallelFile& file, const RunState& s) {
+  file.create_group("/grinding");
+  std::vector<std::int64_t> rows;
+  std::vector<double> bounds;
+  GrindingSizes g = s.grinding.sizes;
+  mpi::sum_in_place(file.comm(), g.product.units());
+  mpi::max_in_place(file.comm(), g.product.neg_low());
+  mpi::max_in_place(file.comm(), g.product.high());
+  for (const SizeMasses* m : {&g.initial, &g.fed, &g.product}) {
+    rows.insert(rows.end(), m->units().begin(), m->units().end());
+    bounds.insert(bounds.end(), m->neg_low().begin(), m->neg_low().end());
+    bounds.insert(bounds.end(), m->high().begin(), m->high().end());
+  }
+  file.write_rows("/grinding/sizes", h5::rank0_rows(file.comm(), rows.size()), rows.data());
+  file.write_rows("/grinding/size_bounds", h5::rank0_rows(file.comm(), bounds.size()),
+                  bounds.data());
+  const double fines = s.grinding.totals.fines_mass;
+  file.write_rows("/grinding/fines_mass", h5::rank0_rows(file.comm(), 1), &fines);
+}
+
 // The resolved deck a checkpoint keeps and compares: without its [[particle]] tables (initial
 // conditions, which the checkpoint's particles replace; a deck of 1e5 of them made a restart
 // parse and compare 14 MB of TOML, 10 s instead of 0.2 s).
@@ -144,6 +167,7 @@ void write_state(h5::ParallelFile& file, const Simulation& sim, int ranks) {
   file.write_strings("/guards/first", firsts);
   file.write_rows("/guards/count", h5::rank0_rows(file.comm(), counts.size()), counts.data());
   write_analysis(file, s);
+  write_sizes(file, s);
 }
 
 // The checksum of this rank's items of `f` summed over the ranks (collective).
@@ -270,6 +294,28 @@ std::vector<std::string> Reader::strings(const std::string& name) const {
   return out;
 }
 
+// A checkpoint written before the size distributions existed has none: they start empty, and
+// the figures drawn from them (F80, P80, sizes.csv) cover the part of the run after the restart.
+void read_sizes(const Reader& in, RunState& s, int my_rank) {
+  if (!in.has("/grinding/sizes")) return;
+  if (in.shape("/grinding/sizes")[0] != kSizeRows) in.fail("/grinding/sizes has the wrong length");
+  if (in.shape("/grinding/size_bounds")[0] != 2 * kSizeRows)
+    in.fail("/grinding/size_bounds has the wrong length");
+  std::vector<std::int64_t> rows(kSizeRows);
+  std::vector<double> bounds(2 * kSizeRows);
+  in.read("/grinding/sizes", H5T_NATIVE_INT64, rows.data());
+  in.read("/grinding/size_bounds", H5T_NATIVE_DOUBLE, bounds.data());
+  GrindingSizes& g = s.grinding.sizes;
+  std::size_t at = 0, b = 0;
+  for (SizeMasses* m : {&g.initial, &g.fed, &g.product}) {
+    for (std::int64_t& u : m->units()) u = rows[at++];
+    for (double& x : m->neg_low()) x = bounds[b++];
+    for (double& x : m->high()) x = bounds[b++];
+  }
+  if (my_rank != 0) g.product = SizeMasses{};  // rank 0 holds the sum
+  in.read("/grinding/fines_mass", H5T_NATIVE_DOUBLE, &s.grinding.totals.fines_mass);
+}
+
 void read_spectra(const Reader& in, RunState& s);
 
 void read_analysis(const Reader& in, RunState& s) {
@@ -344,6 +390,7 @@ RunState read_state(const Reader& in, int my_rank, int my_size) {
   for (std::size_t k = 0; k < kinds.size(); ++k)
     s.guards.push_back({kinds[k], counts[k], firsts[k]});
   read_analysis(in, s);
+  read_sizes(in, s, my_rank);
   return s;
 }
 

@@ -140,6 +140,7 @@ class DeckParser {
     if (const auto* t = root.table("feed")) read_feed(*t);
     if (const auto* t = root.table("sieve")) read_sieve(*t);
     if (const auto* t = root.table("output")) read_output(*t);
+    check_ore(root_);
 
     if (materials.empty() &&
         (drum != nullptr || !fills.empty() || !particles.empty() || !walls.empty())) {
@@ -731,6 +732,25 @@ class DeckParser {
       r.invalid("fragments_max",
                 fmt::format("must be at least fragments_min = {}", b.fragments_min));
     }
+    // The keys of one model or fragment law are errors under the other (rather than unused).
+    const auto only = [&](std::string_view key, bool used, std::string_view by) {
+      if (r.has(key) && !used) r.invalid(key, fmt::format("used only with {}", by));
+    };
+    const bool vp = b.model == BreakageModel::kVogelPeukert;
+    for (const char* key : {"minimum_energy", "strength"})
+      only(key, !vp, "model = \"thesis\"");
+    for (const char* key : {"f_mat", "xw_min"}) only(key, vp, "model = \"vogel-peukert\"");
+    const bool t10 = b.fragments == FragmentLaw::kT10;
+    for (const char* key : {"fragments_mean", "fragments_sd", "fragments_min", "fragments_max"})
+      only(key, !t10, "fragments = \"equal\"");
+    for (const char* key : {"t10_a", "t10_b", "fines_diameter"})
+      only(key, t10, "fragments = \"t10\"");
+    if (vp && !r.has("f_mat")) r.missing("f_mat", "model = \"vogel-peukert\", in kg/(J m)");
+    if (t10) {
+      if (!r.has("t10_a")) r.missing("t10_a", "fragments = \"t10\", in %");
+      if (!r.has("t10_b")) r.missing("t10_b", "fragments = \"t10\", in t/kWh");
+      if (!r.has("fines_diameter")) r.missing("fines_diameter", "fragments = \"t10\", in m");
+    }
   }
 
   void read_feed(const toml::table& table) {
@@ -781,10 +801,73 @@ class DeckParser {
     SieveSpec& s = scene_.sieve;
     s.present = true;
     const Accepted accepted = read_keys(r, deck::kSieve, s);
-    if (!(s.box_max.x > s.box_min.x && s.box_max.y > s.box_min.y)) {
+    const auto only = [&](std::string_view key, DischargeType type, std::string_view word) {
+      if (r.has(key) && s.type != type)
+        r.invalid(key, fmt::format("used only with type = \"{}\"", word));
+    };
+    only("box_min", DischargeType::kBox, "box");
+    only("box_max", DischargeType::kBox, "box");
+    only("grate_width", DischargeType::kGrate, "grate");
+    only("holdup", DischargeType::kOverflow, "overflow");
+    if (s.type == DischargeType::kBox && !(s.box_max.x > s.box_min.x && s.box_max.y > s.box_min.y)) {
       r.invalid(accepted.has("box_max") ? "box_max" : "box_min",
                 fmt::format("the zone must be above and right of box_min = [{}, {}]", s.box_min.x,
                             s.box_min.y));
+    }
+    if (s.type == DischargeType::kGrate) {
+      if (!r.has("grate_width")) {
+        r.missing("grate_width", "type = \"grate\", the ring's radial width in m");
+      } else if (!scene_.drum.present) {
+        r.invalid("type", "a grate needs a [drum] (it lies inside the shell)");
+      } else if (s.grate_width >= scene_.drum.radius) {
+        r.invalid("grate_width", fmt::format("must be below the drum radius {:g} m",
+                                             scene_.drum.radius));
+      }
+    }
+    if (s.type == DischargeType::kOverflow && !r.has("holdup"))
+      r.missing("holdup", "type = \"overflow\", the ore hold-up in kg");
+  }
+
+  // The rules between the ore tables, each message naming the keys on both sides:
+  //   - a particle that cannot break must be able to leave: 2 minimum_radius >= the aperture
+  //     (else the ore between them neither breaks nor leaves);
+  //   - a feed point inside the discharge zone is refused (it would leave at once).
+  void check_ore(const toml::table& root) {
+    const BreakageSpec& b = scene_.breakage;
+    const SieveSpec& s = scene_.sieve;
+    if (!diag_.messages().empty()) return;
+    const auto where = [&](const char* path) {
+      const toml::node* node = root.at_path(path).node();
+      return node != nullptr ? diag_.where(*node) : std::string("the default");
+    };
+    if (b.present && s.present && b.material == s.material &&
+        2.0 * b.minimum_radius < s.aperture) {
+      diag_.error_in(where("breakage.minimum_radius"), fmt::format(
+          "breakage.minimum_radius = {:g} m: particles narrower than 2 x {:g} = {:g} m do "
+          "not break, but only those narrower than sieve.aperture = {:g} m ({}) leave: the ore "
+          "between would stay in the mill for ever; give minimum_radius >= aperture / 2 = {:g} "
+          "m (the aperture is a diameter)",
+          b.minimum_radius, b.minimum_radius,
+          2.0 * b.minimum_radius, s.aperture, where("sieve.aperture"), 0.5 * s.aperture));
+    }
+    const FeedSpec& f = scene_.feed;
+    if (!(f.present && f.has_point && s.present)) return;
+    if (s.type == DischargeType::kBox && f.point.x >= s.box_min.x && f.point.x <= s.box_max.x &&
+        f.point.y >= s.box_min.y && f.point.y <= s.box_max.y) {
+      diag_.error_in(where("feed.point"), fmt::format(
+          "feed.point = [{:g}, {:g}] lies in the sieve's box [{:g}, {:g}] to [{:g}, {:g}] "
+          "({}): fed ore narrower than the aperture would leave at once; give a point outside "
+          "the box",
+          f.point.x, f.point.y, s.box_min.x, s.box_min.y, s.box_max.x,
+          s.box_max.y, where("sieve.box_min")));
+    } else if (s.type == DischargeType::kGrate && scene_.drum.present &&
+               norm(f.point - scene_.drum.center) > scene_.drum.radius - s.grate_width) {
+      diag_.error_in(where("feed.point"), fmt::format(
+          "feed.point = [{:g}, {:g}] lies in the grate ring (the last sieve.grate_width = "
+          "{:g} m inside the shell, {}): fed ore narrower than the aperture would leave at "
+          "once; give a point at most {:g} m from the drum centre",
+          f.point.x, f.point.y, s.grate_width, where("sieve.grate_width"),
+          scene_.drum.radius - s.grate_width));
     }
   }
 

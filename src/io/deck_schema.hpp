@@ -82,6 +82,24 @@ inline constexpr std::array kSizeDistributions = {
     Choice<SizeDistribution>{"table", SizeDistribution::kTable},
 };
 
+inline constexpr std::array kBreakageModels = {
+    Choice<BreakageModel>{"thesis", BreakageModel::kThesis},
+    Choice<BreakageModel>{"vogel-peukert", BreakageModel::kVogelPeukert},
+};
+inline constexpr std::array kEnergySplits = {
+    Choice<EnergySplit>{"compliance", EnergySplit::kCompliance},
+    Choice<EnergySplit>{"whole", EnergySplit::kWhole},
+};
+inline constexpr std::array kFragmentLaws = {
+    Choice<FragmentLaw>{"equal", FragmentLaw::kEqual},
+    Choice<FragmentLaw>{"t10", FragmentLaw::kT10},
+};
+inline constexpr std::array kDischargeTypes = {
+    Choice<DischargeType>{"box", DischargeType::kBox},
+    Choice<DischargeType>{"grate", DischargeType::kGrate},
+    Choice<DischargeType>{"overflow", DischargeType::kOverflow},
+};
+
 // The word for `value` (choices are exhaustive, so one always matches).
 template <class E, std::size_t N>
 constexpr std::string_view choice_name(const std::array<Choice<E>, N>& choices, E value) {
@@ -154,6 +172,7 @@ inline constexpr Bound kMassFraction{0.0, 1.0, false, false};  // [0, 1]
 inline constexpr Bound kGeometricSd{1.0, Bound{}.hi, true, false};  // > 1
 inline constexpr Bound kAtLeastOne{1.0, Bound{}.hi, false, false};  // >= 1 (integers)
 inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (integers)
+inline constexpr Bound kPercent{0.0, 100.0, true, false};           // (0, 100]
 inline constexpr Bound kSizeRatio{1.1, 1e3, false, false};          // [1.1, 1000]
 inline constexpr Bound kSizeEdge{1e-9, 10.0, false, true};          // [1 nm, 10 m)
 // A particle's radius, at least 1 nm: far below any particle a mill holds, and far above where
@@ -852,47 +871,110 @@ inline constexpr Key<BreakageSpec> kBreakageKeys[] = {
      .need = Need::kRequired,
      .field = member<&BreakageSpec::material>(),
      .doc = "the material that breaks (ore); its particles carry `damage`"},
+    {.name = "model",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kBreakageModels>,
+     .field = choice<&BreakageSpec::model, kBreakageModels>(),
+     .doc = "the breakage probability: `\"thesis\"`, P = 1 - exp(-S E_t) on the share's energy "
+            "(J, thesis T34-T36); `\"vogel-peukert\"`, P = 1 - exp(-f_mat d (W_m - W_m,min)) on "
+            "its specific energy W_m (J/kg), a size effect through d (docs/models.md, "
+            "\"Breakage\")"},
+    {.name = "energy_split",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kEnergySplits>,
+     .field = choice<&BreakageSpec::energy_split, kEnergySplits>(),
+     .doc = "each body of a contact takes the share (1 - nu^2)/E of the two compliances of the "
+            "contact's strain energy (`\"compliance\"`), or all of it (`\"whole\"`, the thesis's "
+            "reading)"},
     {.name = "minimum_energy",
      .unit = "J",
      .range = kNonNegative,
      .field = member<&BreakageSpec::minimum_energy>(),
-     .doc = "E_min: a contact whose peak strain energy is below it does no damage (thesis T34, "
-            "Table 1)"},
+     .doc = "thesis model: E_min, a share below it does no damage (thesis T34, Table 1)"},
     {.name = "strength",
      .unit = "1/J",
      .range = kPositive,
      .field = member<&BreakageSpec::strength>(),
-     .doc = "S in the breakage probability P = 1 - exp(-S E_t), E_t = damage + E - E_min "
-            "(thesis T36, Table 1)"},
+     .doc = "thesis model: S in the breakage probability P = 1 - exp(-S E_t), E_t = damage + E "
+            "- E_min (thesis T36, Table 1)"},
+    {.name = "f_mat",
+     .unit = "kg/(J m)",
+     .range = kPositive,
+     .field = member<&BreakageSpec::f_mat>(),
+     .written_if = [](const BreakageSpec& b) { return b.model == BreakageModel::kVogelPeukert; },
+     .allowed = "> 0; required by vogel-peukert",
+     .doc = "vogel-peukert: the material's breakage strength parameter f_mat"},
+    {.name = "xw_min",
+     .unit = "J m/kg",
+     .range = kNonNegative,
+     .field = member<&BreakageSpec::xw_min>(),
+     .written_if = [](const BreakageSpec& b) { return b.model == BreakageModel::kVogelPeukert; },
+     .doc = "vogel-peukert: the diameter times the threshold specific energy, x W_m,min (a "
+            "particle of diameter d needs W_m > xw_min / d)"},
+    {.name = "fragments",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kFragmentLaws>,
+     .field = choice<&BreakageSpec::fragments, kFragmentLaws>(),
+     .doc = "the fragments: `\"equal\"` spheres, their count from a normal law (thesis); "
+            "`\"t10\"`, sizes from the breakage index t10 = A (1 - exp(-b E_cs)), fines below "
+            "`fines_diameter`"},
     {.name = "fragments_mean",
      .range = kPositive,
      .field = member<&BreakageSpec::fragments_mean>(),
-     .doc = "mean of the normal law of the fragment count (rounded, then clipped to "
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kEqual; },
+     .doc = "equal: mean of the normal law of the fragment count (rounded, then clipped to "
             "[fragments_min, fragments_max])"},
     {.name = "fragments_sd",
      .range = kNonNegative,
      .field = member<&BreakageSpec::fragments_sd>(),
-     .doc = "standard deviation of that law (thesis: 99.7 % of counts between 2 and 6)"},
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kEqual; },
+     .doc = "equal: standard deviation of that law (thesis: 99.7 % of counts between 2 and 6)"},
     {.name = "fragments_min",
      .type = Type::kInteger,
      .range = kAtLeastTwo,
      .max = 6,
      .field = member<&BreakageSpec::fragments_min>(),
-     .doc = "fewest fragments"},
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kEqual; },
+     .doc = "equal: fewest fragments"},
     {.name = "fragments_max",
      .type = Type::kInteger,
      .range = kAtLeastTwo,
      .max = 6,
      .field = member<&BreakageSpec::fragments_max>(),
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kEqual; },
      .allowed = "fragments_min to 6",
-     .doc = "most fragments"},
+     .doc = "equal: most fragments"},
+    {.name = "t10_a",
+     .unit = "%",
+     .range = kPercent,
+     .field = member<&BreakageSpec::t10_a>(),
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kT10; },
+     .allowed = "(0, 100]; required by t10",
+     .doc = "t10: A, the largest breakage index (drop-weight test)"},
+    {.name = "t10_b",
+     .unit = "t/kWh",
+     .range = kPositive,
+     .field = member<&BreakageSpec::t10_b>(),
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kT10; },
+     .allowed = "> 0; required by t10",
+     .doc = "t10: b, the breakage index's rise with the specific energy E_cs (kWh/t) of the "
+            "breaking loading"},
+    {.name = "fines_diameter",
+     .unit = "m",
+     .range = kDiameter,
+     .field = member<&BreakageSpec::fines_diameter>(),
+     .written_if = [](const BreakageSpec& b) { return b.fragments == FragmentLaw::kT10; },
+     .allowed = "≥ 2e-09; required by t10",
+     .doc = "t10: progeny below this diameter are fines, which leave the mill with the product "
+            "at once; half of it is the smallest fragment radius, which sets `dt = \"auto\"`"},
     {.name = "minimum_radius",
      .need = Need::kRequired,
      .unit = "m",
      .range = kRadius,
      .field = member<&BreakageSpec::minimum_radius>(),
-     .doc = "smaller particles do not break; the smallest fragment, minimum_radius / "
-            "fragments_max^(1/3), sets `dt = \"auto\"` from the start"},
+     .allowed = "≥ 1e-09; 2 minimum_radius ≥ sieve.aperture",
+     .doc = "smaller particles do not break; with equal fragments the smallest fragment, "
+            "minimum_radius / fragments_max^(1/3), sets `dt = \"auto\"` from the start"},
     {.name = "start",
      .unit = "s",
      .range = kNonNegative,
@@ -962,23 +1044,48 @@ inline constexpr Key<SieveSpec> kSieveKeys[] = {
      .need = Need::kRequired,
      .field = member<&SieveSpec::material>(),
      .doc = "the material it lets through (ore)"},
+    {.name = "type",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kDischargeTypes>,
+     .field = choice<&SieveSpec::type, kDischargeTypes>(),
+     .doc = "where ore narrower than the aperture leaves: `\"box\"`, with its centre in the "
+            "box (the thesis's central sieve); `\"grate\"`, with its centre within `grate_width` "
+            "of the shell (an end grate at the periphery, seen in the plane); `\"overflow\"`, "
+            "the finest first while the ore in the mill exceeds `holdup`"},
     {.name = "box_min",
      .type = Type::kVector,
      .unit = "m",
      .field = member<&SieveSpec::box_min>(),
-     .doc = "lower left corner of the sieve zone (thesis: 1 m x 1 m around the drum centre)"},
+     .written_if = [](const SieveSpec& s) { return s.type == DischargeType::kBox; },
+     .doc = "box: lower left corner of the zone (thesis: 1 m x 1 m around the drum centre)"},
     {.name = "box_max",
      .type = Type::kVector,
      .unit = "m",
      .field = member<&SieveSpec::box_max>(),
+     .written_if = [](const SieveSpec& s) { return s.type == DischargeType::kBox; },
      .allowed = "above and right of `box_min`",
-     .doc = "upper right corner"},
+     .doc = "box: upper right corner"},
+    {.name = "grate_width",
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&SieveSpec::grate_width>(),
+     .written_if = [](const SieveSpec& s) { return s.type == DischargeType::kGrate; },
+     .allowed = "> 0, below the drum radius; required by grate",
+     .doc = "grate: radial width of the open ring inside the shell"},
+    {.name = "holdup",
+     .unit = "kg",
+     .range = kPositive,
+     .field = member<&SieveSpec::holdup>(),
+     .written_if = [](const SieveSpec& s) { return s.type == DischargeType::kOverflow; },
+     .allowed = "> 0; required by overflow",
+     .doc = "overflow: the mass of ore the mill holds; above it the finest ore narrower than "
+            "the aperture leaves (smallest first) until the hold-up is back at it"},
     {.name = "aperture",
      .unit = "m",
      .range = kPositive,
      .field = member<&SieveSpec::aperture>(),
-     .doc = "a particle of the material whose centre is in the zone and whose radius is below "
-            "this leaves the mill as product (the radius is compared)"},
+     .doc = "the opening: ore whose diameter is below it may leave as product (a diameter, as a "
+            "screen's aperture is read)"},
 };
 
 inline constexpr Key<OutputSpec> kOutputKeys[] = {

@@ -15,12 +15,15 @@ namespace dem2d {
 
 OreLogs::OreLogs(const std::string& directory, bool active, double continue_after_time)
     : product_path_(directory + "/" + kProductFile),
-      breakages_path_(directory + "/" + kBreakagesFile) {
+      breakages_path_(directory + "/" + kBreakagesFile),
+      fragments_path_(directory + "/" + kFragmentsFile) {
   if (!active) return;
   for (auto [file, path, header] :
        {std::tuple{&product_, &product_path_, "time,id,radius,mass"},
         std::tuple{&breakages_, &breakages_path_,
-                   "time,parent_id,radius,energy,fragments,first_fragment_id"}}) {
+                   "time,parent_id,radius,energy,fragments,first_fragment_id,mass,"
+                   "specific_energy,t10,fines_mass"},
+        std::tuple{&fragments_, &fragments_path_, "time,parent_id,id,radius,mass"}}) {
     if (continue_after_time >= 0.0) {
       file->reset(continue_csv(*path, header, 0, continue_after_time));
       continue;
@@ -31,12 +34,16 @@ OreLogs::OreLogs(const std::string& directory, bool active, double continue_afte
   }
 }
 
-void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRecord> product) {
+void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRecord> product,
+                    std::vector<FragmentRecord> fragments) {
   if (!product_) return;
   std::sort(breakages.begin(), breakages.end(), [](const auto& a, const auto& b) {
     return a.time < b.time || (a.time == b.time && a.parent < b.parent);
   });
   std::sort(product.begin(), product.end(), [](const auto& a, const auto& b) {
+    return a.time < b.time || (a.time == b.time && a.id < b.id);
+  });
+  std::sort(fragments.begin(), fragments.end(), [](const auto& a, const auto& b) {
     return a.time < b.time || (a.time == b.time && a.id < b.id);
   });
   std::string text;
@@ -46,9 +53,16 @@ void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRe
   if (!text.empty()) put(product_.get(), product_path_, text);
   text.clear();
   for (const BreakageRecord& r : breakages)
-    fmt::format_to(std::back_inserter(text), "{:.17g},{},{:.17g},{:.17g},{},{}\n", r.time, r.parent,
-                   r.radius, r.energy, r.fragments, r.first_id);
+    fmt::format_to(std::back_inserter(text),
+                   "{:.17g},{},{:.17g},{:.17g},{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", r.time,
+                   r.parent, r.radius, r.energy, r.fragments, r.first_id, r.mass,
+                   r.specific_energy, r.t10, r.fines_mass);
   if (!text.empty()) put(breakages_.get(), breakages_path_, text);
+  text.clear();
+  for (const FragmentRecord& r : fragments)
+    fmt::format_to(std::back_inserter(text), "{:.17g},{},{},{:.17g},{:.17g}\n", r.time, r.parent,
+                   r.id, r.radius, r.mass);
+  if (!text.empty()) put(fragments_.get(), fragments_path_, text);
 }
 
 void OreLogs::put(std::FILE* f, const std::string& path, const std::string& text) {

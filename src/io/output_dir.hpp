@@ -34,11 +34,13 @@ inline constexpr const char* kSnapshotsFile = "snapshots.h5";
 inline constexpr const char* kXdmfFile = "snapshots.xmf";
 inline constexpr const char* kProductFile = "product.csv";
 inline constexpr const char* kBreakagesFile = "breakages.csv";
+inline constexpr const char* kFragmentsFile = "fragments.csv";
+inline constexpr const char* kSizesFile = "sizes.csv";
 inline constexpr const char* kCheckpointFile = "checkpoint.h5";
 inline constexpr const char* kCollisionsFile = "collisions.csv";
-inline constexpr const char* kRunOutputs[] = {kRunJsonFile,    kSeriesFile,    kSnapshotsFile,
-                                              kXdmfFile,       kProductFile,   kBreakagesFile,
-                                              kCheckpointFile, kCollisionsFile};
+inline constexpr const char* kRunOutputs[] = {
+    kRunJsonFile,   kSeriesFile, kSnapshotsFile,  kXdmfFile,      kProductFile,
+    kBreakagesFile, kFragmentsFile, kSizesFile, kCheckpointFile, kCollisionsFile};
 inline constexpr const char* kOutputLockName = ".dem2d.lock";
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and

@@ -5,6 +5,7 @@
 
 #include "core/mill/grinding.hpp"
 #include "core/mill/mill_analytics.hpp"
+#include "io/grinding_report.hpp"
 #include "io/text.hpp"
 
 namespace dem2d {
@@ -66,6 +67,7 @@ JsonObject ore_json(const Simulation& sim, const Scene& scene) {
       .add_integer("fragments", t.fragments)
       .add_integer("discharged_count", t.discharged_count)
       .add_number("discharged_mass_kg", t.discharged_mass, "%.10g")
+      .add_number("fines_mass_kg", t.fines_mass, "%.10g")
       .add_number("product_rate_kg_s", sim.time() > 0 ? t.discharged_mass / sim.time() : 0.0,
                   "%.10g")
       .add_number("product_rate_t_h", hours > 0 ? t.discharged_mass / 1000.0 / hours : 0.0,
@@ -106,7 +108,10 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
       .add_integer("particles_at_start", facts.particles_at_start)
       .add_integer("particle_steps", facts.particle_steps)
       .add_number("charge_mass_kg", charge_mass(sim, domain), "%.10g");
-  if (is_ore_scene(scene)) extra.add("ore", ore_json(sim, scene).inline_text());
+  if (is_ore_scene(scene)) {
+    extra.add("ore", ore_json(sim, scene).inline_text());
+    extra.add("grinding", grinding_json(grinding_report(sim, domain)).inline_text());
+  }
   extra.add_integer("neighbor_builds", sim.neighbor_builds());
   if (scene.run.integrator == IntegratorKind::kIterative) {
     extra.add_number("mean_passes",

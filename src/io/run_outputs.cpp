@@ -47,11 +47,12 @@ OreOutput::OreOutput(const Scene& scene, const Simulation& sim, bool resumed) {
 
 void OreOutput::write(Simulation& sim) {
   if (!logs_) return;
-  OreRecords mine{sim.grinding()->take_breakages(), sim.grinding()->take_product()};
+  OreRecords mine{sim.grinding()->take_breakages(), sim.grinding()->take_product(),
+                  sim.grinding()->take_fragments()};
   OreRecords all = gather_ore_records(MPI_COMM_WORLD, mine);
   std::string error;
   try {
-    logs_->write(std::move(all.breakages), std::move(all.product));
+    logs_->write(std::move(all.breakages), std::move(all.product), std::move(all.fragments));
   } catch (const IoError& e) {
     error = e.what();
   }

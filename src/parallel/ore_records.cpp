@@ -10,8 +10,9 @@ namespace dem2d {
 
 namespace {
 
-// One rank's block: [its length, breakage count, breakages (6 words each), products (4 words
-// each), product count]; the reader walks it from both ends.
+// One rank's block: [its length, breakage count, breakages (10 words each), fragment count,
+// fragments (5 words each), products (4 words each), product count]; the reader walks it from
+// both ends.
 std::vector<std::int64_t> encode(const OreRecords& mine) {
   std::vector<std::int64_t> words;
   const auto put = [&words](auto x) {
@@ -23,7 +24,11 @@ std::vector<std::int64_t> encode(const OreRecords& mine) {
   put(mine.breakages.size());
   for (const BreakageRecord& r : mine.breakages) {
     put(r.time), put(r.parent), put(r.radius), put(r.energy), put(r.fragments), put(r.first_id);
+    put(r.mass), put(r.specific_energy), put(r.t10), put(r.fines_mass);
   }
+  put(mine.fragments.size());
+  for (const FragmentRecord& r : mine.fragments)
+    put(r.time), put(r.parent), put(r.id), put(r.radius), put(r.mass);
   for (const ProductRecord& r : mine.product) put(r.time), put(r.id), put(r.radius), put(r.mass);
   put(mine.product.size());  // last: the reader walks each rank's block from both ends
   words.insert(words.begin(), static_cast<std::int64_t>(words.size()) + 1);
@@ -36,9 +41,13 @@ OreRecords decode(const std::vector<std::int64_t>& all) {
   for (std::size_t at = 0; at < all.size(); at += static_cast<std::size_t>(all[at])) {
     const std::int64_t* w = &all[at + 1];
     const std::int64_t nb = *w++;
-    for (std::int64_t k = 0; k < nb; ++k, w += 6)
-      records.breakages.push_back(
-          {real(w[0]), w[1], real(w[2]), real(w[3]), static_cast<int>(w[4]), w[5]});
+    for (std::int64_t k = 0; k < nb; ++k, w += 10)
+      records.breakages.push_back({real(w[0]), w[1], real(w[2]), real(w[3]),
+                                   static_cast<int>(w[4]), w[5], real(w[6]), real(w[7]),
+                                   real(w[8]), real(w[9])});
+    const std::int64_t nf = *w++;
+    for (std::int64_t k = 0; k < nf; ++k, w += 5)
+      records.fragments.push_back({real(w[0]), w[1], w[2], real(w[3]), real(w[4])});
     const std::size_t end = at + static_cast<std::size_t>(all[at]);
     const std::int64_t np = all[end - 1];
     for (std::int64_t k = 0; k < np; ++k, w += 4)

@@ -1,4 +1,4 @@
-// The ore scenes' records (breakages and discharged product, core/mill/grinding.hpp) of every rank,
+// The ore scenes' records (breakages, fragments and discharged product, core/mill/grinding.hpp) of every rank,
 // brought together for the logs that rank 0 writes (io/ore_logs.hpp).
 #pragma once
 
@@ -13,6 +13,7 @@ namespace dem2d {
 struct OreRecords {
   std::vector<BreakageRecord> breakages;
   std::vector<ProductRecord> product;
+  std::vector<FragmentRecord> fragments;
 };
 
 // Collective over `comm`: every rank's records, concatenated in rank order, on every rank. They

@@ -161,6 +161,7 @@ TEST(Grinding, TheSieveRemovesOnlySmallOreInsideItsZone) {
   add("steel", 0.03, {-0.3, 0.3});  // small steel inside
   s.sieve.present = true;
   s.sieve.material = "ore";
+  s.sieve.aperture = 0.07;  // a diameter: the 6 cm ore passes, the 10 cm does not
   Simulation sim(s);
   const double m0 = sim.diagnostics().mill_mass;
   sim.step();
@@ -207,8 +208,9 @@ TEST(Grinding, FedParticlesNeverOverlapAndTheMassBalanceHolds) {
   EXPECT_NEAR(r.mill_mass, m0 + r.fed_mass, 1e-12 * m0);
 }
 
-// Damage accumulates over impacts (T34): an unbreakable ore sphere bounces between two walls;
-// after each contact its damage has grown by that contact's peak strain energy less E_min.
+// Damage accumulates over impacts (T34): an unbreakable ore sphere bounces between two walls of
+// ore; after each contact its damage has grown by its share of that contact's peak strain
+// energy less E_min. Against its own material the share is 1/2 (equal compliances).
 TEST(Grinding, DamageAccumulatesOverImpacts) {
   Scene s = impacts(1, 0.05, 4.0, 1.0e-30);
   s.walls.push_back(segment({0.2, 0.3}, {-0.2, 0.3}, "ore"));  // a ceiling
@@ -222,7 +224,7 @@ TEST(Grinding, DamageAccumulatesOverImpacts) {
     double now = 0.0;
     for (std::size_t k = 0; k < wl.size(); ++k) now = std::max(now, wl.history_of(k)[slot]);
     if (now == 0.0 && peak > 0.0) {  // a contact ended: it was tested at its peak
-      expected += peak - 0.1;
+      expected += 0.5 * peak - 0.1;
       ++impacts_seen;
       EXPECT_NEAR((*sim.particles().damage())[0], expected, 1e-9 * expected);
     }

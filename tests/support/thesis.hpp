@@ -70,8 +70,9 @@ inline FillSpec box_fill(const std::string& material, int count, double r_min, d
 }
 
 // Ore in the thesis drum with 60 balls (ramp 0.1 s): 40 ore spheres of 6 cm that break (E_min
-// 0.01 J, S = 5 1/J, fragments down to 3.5 cm), a feed every 0.02 s and a sieve of aperture
-// 3 cm over the whole drum: breakage, feed and sieve all act within the first 0.3-0.4 s.
+// 0.01 J, S = 5 1/J, fragments down to 3.5 cm), a feed every 0.02 s and a grate of aperture
+// 6 cm in the outer 0.5 m of the drum: breakage, feed and discharge all act within the first
+// 0.3-0.4 s.
 inline Scene grinding_drum_scene() {
   Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
   MaterialSpec ore = thesis_steel();
@@ -92,9 +93,9 @@ inline Scene grinding_drum_scene() {
       .present = true, .material = "ore", .period = 0.02, .radius_min = 0.04, .radius_max = 0.05};
   s.sieve = {.present = true,
              .material = "ore",
-             .box_min = {-2.5, -2.5},
-             .box_max = {2.5, 2.5},
-             .aperture = 0.03};
+             .type = DischargeType::kGrate,
+             .aperture = 0.06,
+             .grate_width = 0.5};
   return s;
 }
 

@@ -6,6 +6,7 @@
 // SI, angles the parser has already converted to radians.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -150,20 +151,44 @@ struct WallSpec {
   Vec2 velocity{0.0, 0.0};  // a translating wall (moves rigidly)
 };
 
-// Ore breakage (docs/models.md, thesis T34-T36): particles of one material break under the
-// peak strain energy of their contacts.
+// Ore breakage (docs/models.md, "Grinding"): particles of one material break under the peak
+// strain energy of their contacts, each body taking its share of a contact's energy.
+enum class BreakageModel { kThesis, kVogelPeukert };
+enum class EnergySplit { kCompliance, kWhole };
+enum class FragmentLaw { kEqual, kT10 };
+
 struct BreakageSpec {
   bool present = false;
-  std::string material;         // the material that breaks (ore)
-  double minimum_energy = 0.1;  // J, E_min: a contact below it does no damage (thesis Table 1)
+  std::string material;  // the material that breaks (ore)
+  BreakageModel model = BreakageModel::kThesis;
+  // A contact's peak strain energy shared by the two bodies in proportion to their compliances
+  // (1 - nu^2) / E (the Hertz approach of each surface), or the whole energy to each (thesis).
+  EnergySplit energy_split = EnergySplit::kCompliance;
+  double minimum_energy = 0.1;  // J, E_min: a share below it does no damage (thesis Table 1)
   double strength = 1.0;        // 1/J, S: P = 1 - exp(-S E_t) (thesis Table 1)
-  double fragments_mean = 4.0;  // fragment count: normal law, rounded and clipped
+  // vogel-peukert: P = 1 - exp(-f_mat d (W_m - W_m,min)) per loading, W_m,min = xw_min / d.
+  double f_mat = 0.0;   // kg/(J m)
+  double xw_min = 0.0;  // J m/kg: the size times the threshold specific energy
+  FragmentLaw fragments = FragmentLaw::kEqual;
+  double fragments_mean = 4.0;  // equal: the fragment count's normal law, rounded and clipped
   double fragments_sd = 2.0 / 3.0;
   int fragments_min = 2;
   int fragments_max = 6;
+  // t10: t10 = A (1 - exp(-b E_cs)) (%), E_cs the breaking loading's specific energy (kWh/t);
+  // progeny passing (x / X)^alpha with t10 = (1/10)^alpha; below fines_diameter: fines.
+  double t10_a = 0.0;           // %
+  double t10_b = 0.0;           // t/kWh
+  double fines_diameter = 0.0;  // m
   double minimum_radius = 0.0;  // m: particles smaller than this do not break
   double start = 0.0;           // s: contacts that peak before this time do no damage
 };
+
+// The smallest fragment a break can make (m): equal fragments of the smallest breakable particle,
+// or half the fines diameter (t10 progeny are coarser).
+inline double smallest_fragment_radius(const BreakageSpec& b) {
+  if (b.fragments == FragmentLaw::kT10) return 0.5 * b.fines_diameter;
+  return b.minimum_radius / std::cbrt(static_cast<double>(b.fragments_max));
+}
 
 // Ore feed: one particle every `period` s (or as a mass rate), radius uniform in
 // [radius_min, radius_max], where the charge is thinnest or at `point`.
@@ -180,13 +205,21 @@ struct FeedSpec {
   Vec2 velocity{0.0, 0.0};
 };
 
-// The sieve: ore whose centre is inside the box and whose radius is below the aperture leaves.
+// The discharge ([sieve]): ore narrower than the aperture (a diameter) leaves the mill where
+// the type says: in the box (the thesis's central sieve), in the grate zone at the shell (an
+// end grate seen in the plane), or, overflow, the finest first while the ore hold-up exceeds
+// `holdup`.
+enum class DischargeType { kBox, kGrate, kOverflow };
+
 struct SieveSpec {
   bool present = false;
-  std::string material;      // the material it lets through (ore)
-  Vec2 box_min{-0.5, -0.5};  // thesis: 1 m x 1 m around the drum centre
+  std::string material;  // the material it lets through (ore)
+  DischargeType type = DischargeType::kBox;
+  Vec2 box_min{-0.5, -0.5};  // box: thesis: 1 m x 1 m around the drum centre
   Vec2 box_max{0.5, 0.5};
-  double aperture = 0.04;  // m, compared with the radius (docs/models.md, "Sieve")
+  double aperture = 0.04;     // m, compared with the diameter
+  double grate_width = 0.0;   // m, grate: radial width of the zone inside the shell
+  double holdup = 0.0;        // kg, overflow: the ore hold-up the mill keeps
 };
 
 struct OutputSpec {

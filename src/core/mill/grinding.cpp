@@ -1,13 +1,18 @@
 #include "core/mill/grinding.hpp"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <numbers>
 
 #include "core/base/random.hpp"
 #include "core/contact/contact_models.hpp"
+#include "core/base/errors.hpp"
 #include "core/geometry/drum_geometry.hpp"
+#include "core/geometry/walls.hpp"
+#include "core/mill/breakage_laws.hpp"
 #include "core/shape/disc.hpp"
 
 namespace dem2d {
@@ -28,25 +33,55 @@ Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& dom
   if (scene.breakage.present) break_material_ = find_material(scene, scene.breakage.material);
   if (scene.feed.present) feed_material_ = find_material(scene, scene.feed.material);
   if (scene.sieve.present) sieve_material_ = find_material(scene, scene.sieve.material);
+  for (const MaterialSpec& m : scene.materials)
+    compliance_.push_back(compliance(m.youngs_modulus, m.poisson_ratio));
+  if (break_material_ >= 0) {
+    const Walls walls(scene);
+    for (const WallElement& e : walls.elements()) element_material_.push_back(e.material);
+  }
   double largest = -1.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k)
     largest = std::max(largest, static_cast<double>(p.id[k]));
   next_id_ = static_cast<std::int64_t>(domain.max(largest)) + 1;
   next_feed_try_ = scene.feed.start;
+  // The ore at the start, by size (exact integers summed over ranks).
+  const int ore = ore_material();
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    if (p.material[k] == ore) sizes_.initial.add(2.0 * p.radius[k], p.mass[k]);
+  combine(sizes_.initial, domain);
+  if (scene.sieve.present && scene.sieve.type == DischargeType::kGrate)
+    grate_inner_ = DrumGeometry(scene.drum).inner_radius() - scene.sieve.grate_width;
   if (scene.feed.present && scene.drum.present) {
-    // Candidate feed points: rings inside the drum clear of the shell and the lifters.
+    // Candidate feed points: rings inside the drum clear of the shell and the lifters, outside
+    // the discharge zone (a fed particle would leave there at once).
     const DrumSpec& d = scene.drum;
     const double reach = DrumGeometry(d).clear_radius();
     feed_reach_ = reach;
-    candidates_.push_back(d.center);
+    const double r_max = scene.feed.radius_max;
+    const auto keep = [&](Vec2 x) {
+      if (!scene.sieve.present || scene.sieve.material != scene.feed.material) return true;
+      const SieveSpec& s = scene.sieve;
+      if (s.type == DischargeType::kGrate) return norm(x - d.center) + r_max <= grate_inner_;
+      if (s.type == DischargeType::kBox)
+        return x.x + r_max < s.box_min.x || x.x - r_max > s.box_max.x ||
+               x.y + r_max < s.box_min.y || x.y - r_max > s.box_max.y;
+      return true;
+    };
+    if (keep(d.center)) candidates_.push_back(d.center);
     for (int ring = 1; ring <= 6; ++ring) {
-      const double radius = (reach - scene.feed.radius_max) * ring / 6.0;
+      const double radius = (reach - r_max) * ring / 6.0;
       const int n = 8 * ring;
       for (int k = 0; k < n; ++k) {
         const double a = 2.0 * std::numbers::pi * (k + 0.5 * (ring % 2)) / n;
-        candidates_.push_back(d.center + radius * Vec2{std::cos(a), std::sin(a)});
+        const Vec2 x = d.center + radius * Vec2{std::cos(a), std::sin(a)};
+        if (keep(x)) candidates_.push_back(x);
       }
     }
+    if (candidates_.empty() && !scene.feed.has_point)
+      throw InputError(scene.deck_path +
+                       ": [feed]: every place the feed could put a particle lies in the "
+                       "discharge zone of [sieve] (or too close to it for radius_max); make the "
+                       "zone smaller or give feed.point outside it");
   }
 }
 
@@ -65,7 +100,7 @@ bool Grinding::plan(double time, std::int64_t step, const ParticleStore& p,
   plan_.product.clear();
   plan_.sieved = 0;
   plan_.sieved_mass = 0.0;
-  if (sieve_material_ >= 0) sieve(time, p);
+  if (sieve_material_ >= 0) discharge(time, p, domain);
   plan_.changes = domain.sum(static_cast<std::int64_t>(plan_.broken.size()) +
                              plan_.sieved);  // one collective per step
   plan_.feed = feed_due(time);
@@ -102,9 +137,12 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
       remove[k] = 2;
     }
     for (std::size_t k = 0; k < p.n_owned(); ++k)
-      if (remove[k] == 1) ledger.discharged += mechanical_energy(p, k, scene_.run.gravity);
+      if (remove[k] == 1) {
+        ledger.discharged += mechanical_energy(p, k, scene_.run.gravity);
+        sizes_.product.add(2.0 * p.radius[k], p.mass[k]);
+      }
     p.remove_if(remove);
-    break_parents(time, parents, p, domain);
+    break_parents(time, parents, p, domain, ledger);
     totals_.discharged_count += domain.sum(plan_.sieved);
     totals_.discharged_mass += domain.sum(plan_.sieved_mass);
   }
@@ -139,8 +177,15 @@ void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contac
     const double* h = pair_h + k * pl.width + off;
     const std::int32_t i = pl.i[k], j = pl.j[k];
     const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
-    if (breakable(i)) out.push_back({pl.id_i[k], pl.id_j[k], std::size_t(i), peak, tested});
-    if (breakable(j)) out.push_back({pl.id_j[k], pl.id_i[k], std::size_t(j), peak, tested});
+    // One loading event, tested once: each breakable body with its share of the energy.
+    if (breakable(i)) {
+      const double s = share(p.material[i], p.material[j]);
+      out.push_back({pl.id_i[k], pl.id_j[k], std::size_t(i), s * peak, s * tested});
+    }
+    if (breakable(j)) {
+      const double s = share(p.material[j], p.material[i]);
+      out.push_back({pl.id_j[k], pl.id_i[k], std::size_t(j), s * peak, s * tested});
+    }
     plan_.tested_pairs.push_back(entry);
   }
   const WallPairList& wl = contacts.wall_pairs();
@@ -150,8 +195,12 @@ void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contac
     const double peak = h[TrackBreakage::kPeak], tested = h[TrackBreakage::kTested];
     if (!TrackBreakage::test_due(peak, h[TrackBreakage::kEnergy], tested)) continue;
     const std::int32_t i = wl.particle[k];
-    if (breakable(i))
-      out.push_back({wl.id[k], -1 - std::int64_t{wl.element[k]}, std::size_t(i), peak, tested});
+    if (breakable(i)) {
+      const double s =
+          share(p.material[i], element_material_[static_cast<std::size_t>(wl.element[k])]);
+      out.push_back(
+          {wl.id[k], -1 - std::int64_t{wl.element[k]}, std::size_t(i), s * peak, s * tested});
+    }
     plan_.tested_walls.push_back(static_cast<std::int32_t>(k));
   }
   std::sort(out.begin(), out.end(), [](const Test& a, const Test& b) {
@@ -165,31 +214,48 @@ void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contac
 void Grinding::run_tests(const std::vector<Test>& tests, std::int64_t step,
                          const ParticleStore& p) {
   const BreakageSpec& b = scene_.breakage;
+  const bool vp = b.model == BreakageModel::kVogelPeukert;
   const std::uint64_t seed = stream(scene_.run.seed, kStreamTest);
   const Field<double>& damage = *p.damage();
   std::vector<Broken>& broken = plan_.broken;
   std::int64_t last_broken = -1, last_damaged = -1;
   for (const Test& t : tests) {
     if (t.id == last_broken) continue;  // already broken in this step
-    const double energy = t.peak - std::max(t.tested, b.minimum_energy);
-    if (energy <= 0.0) continue;
     const double before = t.id == last_damaged ? plan_.damage.back().second : damage[t.index];
-    const double e_t = before + energy;
-    const double probability = 1.0 - std::exp(-b.strength * e_t);
+    double probability = 0.0, after = before;
+    if (vp) {
+      // The specific energy of the loading above the level tested and the size's threshold.
+      const double m = p.mass[t.index], d = 2.0 * p.radius[t.index];
+      const double w = (t.peak - std::max(t.tested, b.xw_min / d * m)) / m;
+      if (w <= 0.0) continue;
+      probability = vogel_peukert_probability(b.f_mat, 0.0, d, w);
+      after = before + w;
+    } else {
+      const double energy = t.peak - std::max(t.tested, b.minimum_energy);
+      if (energy <= 0.0) continue;
+      after = before + energy;
+      probability = 1.0 - std::exp(-b.strength * after);
+    }
     const std::uint64_t key =
         mix64(static_cast<std::uint64_t>(t.id)) ^ static_cast<std::uint64_t>(t.partner);
     if (random_uniform(seed, key, static_cast<std::uint64_t>(step)) < probability) {
       broken.push_back({t.index, t.peak});
       last_broken = t.id;
     } else if (t.id == last_damaged) {
-      plan_.damage.back().second = e_t;
+      plan_.damage.back().second = after;
     } else {
-      plan_.damage.emplace_back(t.index, e_t);
+      plan_.damage.emplace_back(t.index, after);
       last_damaged = t.id;
     }
   }
   std::sort(broken.begin(), broken.end(),
             [](const Broken& x, const Broken& y) { return x.index < y.index; });
+}
+
+double Grinding::share(int material, int partner_material) const {
+  if (scene_.breakage.energy_split == EnergySplit::kWhole) return 1.0;
+  return energy_share(compliance_[static_cast<std::size_t>(material)],
+                      compliance_[static_cast<std::size_t>(partner_material)]);
 }
 
 int Grinding::fragment_count(std::int64_t parent) const {
@@ -201,51 +267,149 @@ int Grinding::fragment_count(std::int64_t parent) const {
 }
 
 // Every rank's parents of this step, sorted by id, take the next ids in turn; this rank's are
-// replaced by their fragments (the parents are already out of the store).
+// replaced by their fragments (the parents are already out of the store). The fines of a t10
+// break leave with the product (their energy booked as discharged).
 void Grinding::break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
-                             Domain& domain) {
+                             Domain& domain, EnergyLedger& ledger) {
+  const BreakageSpec& b = scene_.breakage;
   std::vector<std::int64_t> mine;
   for (const Parent& parent : parents) mine.push_back(parent.id);
-  std::vector<std::int64_t> all = domain.allgather(mine);
-  std::sort(all.begin(), all.end());
+  // The fragment counts of a t10 break are known only to the parent's owner: every rank's
+  // parents with their counts, (id, count) pairs.
+  std::vector<Progeny> progeny(parents.size());
+  std::vector<std::int64_t> mine_counts;
+  for (std::size_t k = 0; k < parents.size(); ++k) {
+    const Parent& q = parents[k];
+    mine_counts.push_back(q.id);
+    if (b.fragments == FragmentLaw::kT10) {
+      const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
+      const double e_cs = q.energy / Disc::mass(q.radius, density) / 3600.0;  // kWh/t
+      const double alpha = progeny_exponent(t10_fraction(b.t10_a, b.t10_b, e_cs));
+      progeny[k] = t10_progeny(q.radius, density, alpha, b.fines_diameter);
+      mine_counts.push_back(static_cast<std::int64_t>(progeny[k].radii.size()));
+    } else {
+      mine_counts.push_back(fragment_count(q.id));
+    }
+  }
+  std::vector<std::int64_t> all = domain.allgather(mine_counts);
+  std::vector<std::pair<std::int64_t, std::int64_t>> order;
+  for (std::size_t k = 0; k + 1 < all.size(); k += 2) order.emplace_back(all[k], all[k + 1]);
+  std::sort(order.begin(), order.end());
   std::int64_t id = next_id_;
   const std::uint64_t seed = stream(scene_.run.seed, kStreamFragments);
-  for (const std::int64_t parent_id : all) {
-    const int n = fragment_count(parent_id);
+  double fines = 0.0;
+  for (const auto& [parent_id, count] : order) {
+    const int n = static_cast<int>(count);
     const auto it = std::find(mine.begin(), mine.end(), parent_id);
     if (it != mine.end()) {
-      const Parent& q = parents[static_cast<std::size_t>(it - mine.begin())];
-      breakages_.push_back({time, q.id, q.radius, q.energy, n, id});
-      const double r_f = q.radius / std::cbrt(static_cast<double>(n));
+      const std::size_t k = static_cast<std::size_t>(it - mine.begin());
+      const Parent& q = parents[k];
+      const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
+      const double mass = Disc::mass(q.radius, density);
       const double turn =
           2.0 * std::numbers::pi * random_uniform(seed, static_cast<std::uint64_t>(q.id), 1);
-      const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
-      for (int f = 0; f < n; ++f) {
-        const double a = turn + 2.0 * std::numbers::pi * f / n;
-        const Vec2 offset = (q.radius - r_f) * Vec2{std::cos(a), std::sin(a)};
-        p.add(id + f, q.material, r_f, density, q.x + offset,
+      BreakageRecord record{time, q.id, q.radius, q.energy, n, id, mass, q.energy / mass};
+      const auto born = [&](std::int64_t fid, double r_f, Vec2 offset) {
+        p.add(fid, q.material, r_f, density, q.x + offset,
               q.v + q.omega * Vec2{-offset.y, offset.x}, q.omega);
+        fragment_log_.push_back({time, q.id, fid, r_f, Disc::mass(r_f, density)});
+      };
+      if (b.fragments == FragmentLaw::kT10) {
+        const Progeny& g = progeny[k];
+        const std::vector<Offset> at = fragment_offsets(q.radius, g.radii, turn);
+        for (int f = 0; f < n; ++f) {
+          const std::size_t fk = static_cast<std::size_t>(f);
+          born(id + f, g.radii[fk], Vec2{at[fk].x, at[fk].y});
+        }
+        record.fines_mass = g.fines_mass;
+        if (g.fines_mass > 0.0) {
+          // The fines: a point mass at the parent's centre with its velocity, out at once.
+          ledger.discharged +=
+              g.fines_mass * (0.5 * norm2(q.v) - dot(scene_.run.gravity, q.x));
+          sizes_.product.add_fines(g.fines_mass, g.fines_law_mass,
+                                   std::min(b.fines_diameter, 2.0 * q.radius), g.alpha);
+          fines += g.fines_mass;
+        }
+        // t10 as the progeny gives it: the fragments below a tenth plus the fines there.
+        double below = 0.0;
+        for (const double r_f : g.radii)
+          if (2.0 * r_f < 0.2 * q.radius) below += Disc::mass(r_f, density);
+        const double tenth = 0.2 * q.radius;
+        below += tenth >= b.fines_diameter
+                     ? g.fines_mass
+                     : g.fines_law_mass * std::pow(tenth / b.fines_diameter, g.alpha);
+        record.t10 = 100.0 * below / mass;
+      } else {
+        const double r_f = q.radius / std::cbrt(static_cast<double>(n));
+        for (int f = 0; f < n; ++f) {
+          const double a = turn + 2.0 * std::numbers::pi * f / n;
+          born(id + f, r_f, (q.radius - r_f) * Vec2{std::cos(a), std::sin(a)});
+        }
       }
+      breakages_.push_back(record);
     }
     id += n;
     totals_.breakages += 1;
     totals_.fragments += n;
   }
   next_id_ = id;
+  if (b.fragments == FragmentLaw::kT10) {
+    const double all_fines = domain.sum(fines);
+    totals_.fines_mass += all_fines;
+    totals_.discharged_mass += all_fines;
+  }
 }
 
-void Grinding::sieve(double time, const ParticleStore& p) {
+bool Grinding::in_zone(Vec2 x) const {
   const SieveSpec& s = scene_.sieve;
-  for (std::size_t k = 0; k < p.n_owned(); ++k) {
-    const Vec2 x = p.pos[k];
-    if (p.material[k] != sieve_material_ || !(p.radius[k] < s.aperture) || x.x < s.box_min.x ||
-        x.x > s.box_max.x || x.y < s.box_min.y || x.y > s.box_max.y)
-      continue;
+  if (s.type == DischargeType::kGrate) return norm(x - scene_.drum.center) > grate_inner_;
+  return x.x >= s.box_min.x && x.x <= s.box_max.x && x.y >= s.box_min.y && x.y <= s.box_max.y;
+}
+
+// The ore narrower than the aperture that leaves in this step: in the zone (box, grate), or,
+// overflow, the finest (then the lowest id) while the ore hold-up exceeds the limit; the
+// hold-up is an exact integer sum over ranks, so every rank count decides alike.
+void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
+  const SieveSpec& s = scene_.sieve;
+  const auto out = [&](std::size_t k) {
     plan_.remove[k] = 1;
     plan_.product.push_back({time, p.id[k], p.radius[k], p.mass[k]});
     plan_.sieved_mass += p.mass[k];
     ++plan_.sieved;
+  };
+  if (s.type != DischargeType::kOverflow) {
+    for (std::size_t k = 0; k < p.n_owned(); ++k)
+      if (p.material[k] == sieve_material_ && 2.0 * p.radius[k] < s.aperture && in_zone(p.pos[k]))
+        out(k);
+    return;
   }
+  std::int64_t held = 0;
+  std::vector<std::int64_t> fine;  // (radius bits, id, mass units) of the candidates
+  for (std::size_t k = 0; k < p.n_owned(); ++k) {
+    if (p.material[k] != sieve_material_) continue;
+    held += SizeMasses::units(p.mass[k]);
+    if (2.0 * p.radius[k] < s.aperture)
+      fine.insert(fine.end(), {std::bit_cast<std::int64_t>(p.radius[k]), p.id[k],
+                               SizeMasses::units(p.mass[k])});
+  }
+  held = domain.sum(held);
+  const std::int64_t limit = SizeMasses::units(s.holdup);
+  if (held <= limit) return;
+  std::vector<std::int64_t> all = domain.allgather(fine);
+  std::vector<std::array<std::int64_t, 3>> c;
+  for (std::size_t k = 0; k + 2 < all.size(); k += 3) c.push_back({all[k], all[k + 1], all[k + 2]});
+  std::sort(c.begin(), c.end());  // positive radii: their bits order as the values
+  std::vector<std::int64_t> leaving;
+  for (const auto& x : c) {
+    if (held <= limit) break;
+    leaving.push_back(x[1]);
+    held -= x[2];
+  }
+  std::sort(leaving.begin(), leaving.end());
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    if (p.material[k] == sieve_material_ &&
+        std::binary_search(leaving.begin(), leaving.end(), p.id[k]))
+      out(k);
 }
 
 bool Grinding::feed_due(double time) const {
@@ -297,6 +461,7 @@ bool Grinding::feed(double time, ParticleStore& p, Domain& domain, EnergyLedger&
   ++next_id_;
   totals_.fed_count += 1;
   totals_.fed_mass += mass;
+  sizes_.fed.add(2.0 * r, mass);
   return true;
 }
 
@@ -316,5 +481,29 @@ void Grinding::exclude_births(ContactEngine& contacts) const {
 
 std::vector<BreakageRecord> Grinding::take_breakages() { return std::exchange(breakages_, {}); }
 std::vector<ProductRecord> Grinding::take_product() { return std::exchange(product_, {}); }
+std::vector<FragmentRecord> Grinding::take_fragments() {
+  return std::exchange(fragment_log_, {});
+}
+
+void combine(SizeMasses& m, const Domain& domain) {
+  domain.sum(m.units());
+  domain.max(m.neg_low());
+  domain.max(m.high());
+}
+
+GrindingSizes Grinding::sizes(const Domain& domain) const {
+  GrindingSizes s = sizes_;
+  combine(s.product, domain);
+  return s;
+}
+
+SizeMasses Grinding::mill_sizes(const ParticleStore& p, const Domain& domain) const {
+  SizeMasses m;
+  const int ore = ore_material();
+  for (std::size_t k = 0; k < p.n_owned(); ++k)
+    if (p.material[k] == ore) m.add(2.0 * p.radius[k], p.mass[k]);
+  combine(m, domain);
+  return m;
+}
 
 }  // namespace dem2d

@@ -284,7 +284,7 @@ double smallest_radius(const Scene& s, const ParticleStore& p) {
   for (std::size_t k = 0; k < p.size(); ++k) r = std::min(r, p.radius[k]);
   if (s.feed.present) r = std::min(r, s.feed.radius_min);
   if (s.breakage.present) {
-    r = std::min(r, s.breakage.minimum_radius / std::cbrt(double(s.breakage.fragments_max)));
+    r = std::min(r, smallest_fragment_radius(s.breakage));
   }
   return r;
 }

@@ -109,8 +109,7 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   // fragments get small): a fragment of the smallest breakable particle, and the smallest fed.
   if (scene.breakage.present) {
     const int m = find_material(scene, scene.breakage.material);
-    const double smallest = scene.breakage.minimum_radius /
-                            std::cbrt(static_cast<double>(scene.breakage.fragments_max));
+    const double smallest = smallest_fragment_radius(scene.breakage);
     if (m >= 0 && r_min[m] != std::numeric_limits<double>::max())
       r_min[m] = std::min(r_min[m], smallest);
   }
