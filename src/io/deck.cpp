@@ -737,8 +737,7 @@ class DeckParser {
       if (r.has(key) && !used) r.invalid(key, fmt::format("used only with {}", by));
     };
     const bool vp = b.model == BreakageModel::kVogelPeukert;
-    for (const char* key : {"minimum_energy", "strength"})
-      only(key, !vp, "model = \"thesis\"");
+    for (const char* key : {"minimum_energy", "strength"}) only(key, !vp, "model = \"thesis\"");
     for (const char* key : {"f_mat", "xw_min"}) only(key, vp, "model = \"vogel-peukert\"");
     const bool t10 = b.fragments == FragmentLaw::kT10;
     for (const char* key : {"fragments_mean", "fragments_sd", "fragments_min", "fragments_max"})
@@ -809,7 +808,8 @@ class DeckParser {
     only("box_max", DischargeType::kBox, "box");
     only("grate_width", DischargeType::kGrate, "grate");
     only("holdup", DischargeType::kOverflow, "overflow");
-    if (s.type == DischargeType::kBox && !(s.box_max.x > s.box_min.x && s.box_max.y > s.box_min.y)) {
+    if (s.type == DischargeType::kBox &&
+        !(s.box_max.x > s.box_min.x && s.box_max.y > s.box_min.y)) {
       r.invalid(accepted.has("box_max") ? "box_max" : "box_min",
                 fmt::format("the zone must be above and right of box_min = [{}, {}]", s.box_min.x,
                             s.box_min.y));
@@ -820,8 +820,8 @@ class DeckParser {
       } else if (!scene_.drum.present) {
         r.invalid("type", "a grate needs a [drum] (it lies inside the shell)");
       } else if (s.grate_width >= scene_.drum.radius) {
-        r.invalid("grate_width", fmt::format("must be below the drum radius {:g} m",
-                                             scene_.drum.radius));
+        r.invalid("grate_width",
+                  fmt::format("must be below the drum radius {:g} m", scene_.drum.radius));
       }
     }
     if (s.type == DischargeType::kOverflow && !r.has("holdup"))
@@ -840,34 +840,39 @@ class DeckParser {
       const toml::node* node = root.at_path(path).node();
       return node != nullptr ? diag_.where(*node) : std::string("the default");
     };
-    if (b.present && s.present && b.material == s.material &&
-        2.0 * b.minimum_radius < s.aperture) {
-      diag_.error_in(where("breakage.minimum_radius"), fmt::format(
-          "breakage.minimum_radius = {:g} m: particles narrower than 2 x {:g} = {:g} m do "
-          "not break, but only those narrower than sieve.aperture = {:g} m ({}) leave: the ore "
-          "between would stay in the mill for ever; give minimum_radius >= aperture / 2 = {:g} "
-          "m (the aperture is a diameter)",
-          b.minimum_radius, b.minimum_radius,
-          2.0 * b.minimum_radius, s.aperture, where("sieve.aperture"), 0.5 * s.aperture));
+    if (b.present && s.present && b.material == s.material && 2.0 * b.minimum_radius < s.aperture) {
+      diag_.error_in(
+          where("breakage.minimum_radius"),
+          fmt::format(
+              "breakage.minimum_radius = {:g} m: particles narrower than 2 x {:g} = {:g} m do "
+              "not break, but only those narrower than sieve.aperture = {:g} m ({}) leave: the ore "
+              "between would stay in the mill for ever; give minimum_radius >= aperture / 2 = {:g} "
+              "m (the aperture is a diameter)",
+              b.minimum_radius, b.minimum_radius, 2.0 * b.minimum_radius, s.aperture,
+              where("sieve.aperture"), 0.5 * s.aperture));
     }
     const FeedSpec& f = scene_.feed;
     if (!(f.present && f.has_point && s.present)) return;
     if (s.type == DischargeType::kBox && f.point.x >= s.box_min.x && f.point.x <= s.box_max.x &&
         f.point.y >= s.box_min.y && f.point.y <= s.box_max.y) {
-      diag_.error_in(where("feed.point"), fmt::format(
-          "feed.point = [{:g}, {:g}] lies in the sieve's box [{:g}, {:g}] to [{:g}, {:g}] "
-          "({}): fed ore narrower than the aperture would leave at once; give a point outside "
-          "the box",
-          f.point.x, f.point.y, s.box_min.x, s.box_min.y, s.box_max.x,
-          s.box_max.y, where("sieve.box_min")));
+      diag_.error_in(
+          where("feed.point"),
+          fmt::format(
+              "feed.point = [{:g}, {:g}] lies in the sieve's box [{:g}, {:g}] to [{:g}, {:g}] "
+              "({}): fed ore narrower than the aperture would leave at once; give a point outside "
+              "the box",
+              f.point.x, f.point.y, s.box_min.x, s.box_min.y, s.box_max.x, s.box_max.y,
+              where("sieve.box_min")));
     } else if (s.type == DischargeType::kGrate && scene_.drum.present &&
                norm(f.point - scene_.drum.center) > scene_.drum.radius - s.grate_width) {
-      diag_.error_in(where("feed.point"), fmt::format(
-          "feed.point = [{:g}, {:g}] lies in the grate ring (the last sieve.grate_width = "
-          "{:g} m inside the shell, {}): fed ore narrower than the aperture would leave at "
-          "once; give a point at most {:g} m from the drum centre",
-          f.point.x, f.point.y, s.grate_width, where("sieve.grate_width"),
-          scene_.drum.radius - s.grate_width));
+      diag_.error_in(
+          where("feed.point"),
+          fmt::format(
+              "feed.point = [{:g}, {:g}] lies in the grate ring (the last sieve.grate_width = "
+              "{:g} m inside the shell, {}): fed ore narrower than the aperture would leave at "
+              "once; give a point at most {:g} m from the drum centre",
+              f.point.x, f.point.y, s.grate_width, where("sieve.grate_width"),
+              scene_.drum.radius - s.grate_width));
     }
   }
 

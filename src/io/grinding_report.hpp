@@ -19,12 +19,12 @@ inline constexpr const char* kSliceCaveat =
     "scale-up (docs/models.md, \"Grinding\")";
 
 struct GrindingReport {
-  GrindingSizes sizes;  // the product summed over ranks
-  SizeMasses mill;      // the ore in the mill now
-  double drum_work = 0.0;      // J since the start
-  double product_mass = 0.0;   // kg: discharged particles and fines
-  double fines_mass = 0.0;     // kg
-  double aperture = 0.0;       // m, 0 without a [sieve]
+  GrindingSizes sizes;        // the product summed over ranks
+  SizeMasses mill;            // the ore in the mill now
+  double drum_work = 0.0;     // J since the start
+  double product_mass = 0.0;  // kg: discharged particles and fines
+  double fines_mass = 0.0;    // kg
+  double aperture = 0.0;      // m, 0 without a [sieve]
   double time = 0.0;
 };
 

@@ -55,8 +55,8 @@ void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRe
   for (const BreakageRecord& r : breakages)
     fmt::format_to(std::back_inserter(text),
                    "{:.17g},{},{:.17g},{:.17g},{},{},{:.17g},{:.17g},{:.17g},{:.17g}\n", r.time,
-                   r.parent, r.radius, r.energy, r.fragments, r.first_id, r.mass,
-                   r.specific_energy, r.t10, r.fines_mass);
+                   r.parent, r.radius, r.energy, r.fragments, r.first_id, r.mass, r.specific_energy,
+                   r.t10, r.fines_mass);
   if (!text.empty()) put(breakages_.get(), breakages_path_, text);
   text.clear();
   for (const FragmentRecord& r : fragments)

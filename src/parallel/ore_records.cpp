@@ -42,9 +42,8 @@ OreRecords decode(const std::vector<std::int64_t>& all) {
     const std::int64_t* w = &all[at + 1];
     const std::int64_t nb = *w++;
     for (std::int64_t k = 0; k < nb; ++k, w += 10)
-      records.breakages.push_back({real(w[0]), w[1], real(w[2]), real(w[3]),
-                                   static_cast<int>(w[4]), w[5], real(w[6]), real(w[7]),
-                                   real(w[8]), real(w[9])});
+      records.breakages.push_back({real(w[0]), w[1], real(w[2]), real(w[3]), static_cast<int>(w[4]),
+                                   w[5], real(w[6]), real(w[7]), real(w[8]), real(w[9])});
     const std::int64_t nf = *w++;
     for (std::int64_t k = 0; k < nf; ++k, w += 5)
       records.fragments.push_back({real(w[0]), w[1], w[2], real(w[3]), real(w[4])});

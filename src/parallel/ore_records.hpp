@@ -1,5 +1,5 @@
-// The ore scenes' records (breakages, fragments and discharged product, core/mill/grinding.hpp) of every rank,
-// brought together for the logs that rank 0 writes (io/ore_logs.hpp).
+// The ore scenes' records (breakages, fragments and discharged product, core/mill/grinding.hpp) of
+// every rank, brought together for the logs that rank 0 writes (io/ore_logs.hpp).
 #pragma once
 
 #include <mpi.h>

@@ -217,9 +217,9 @@ struct SieveSpec {
   DischargeType type = DischargeType::kBox;
   Vec2 box_min{-0.5, -0.5};  // box: thesis: 1 m x 1 m around the drum centre
   Vec2 box_max{0.5, 0.5};
-  double aperture = 0.04;     // m, compared with the diameter
-  double grate_width = 0.0;   // m, grate: radial width of the zone inside the shell
-  double holdup = 0.0;        // kg, overflow: the ore hold-up the mill keeps
+  double aperture = 0.04;    // m, compared with the diameter
+  double grate_width = 0.0;  // m, grate: radial width of the zone inside the shell
+  double holdup = 0.0;       // kg, overflow: the ore hold-up the mill keeps
 };
 
 struct OutputSpec {

@@ -76,8 +76,8 @@ std::vector<Offset> fragment_offsets(double parent_radius, const std::vector<dou
     spread += mk * (o[k].x * o[k].x + o[k].y * o[k].y);
     own += 0.4 * mk * radii[k] * radii[k];
   }
-  const double parent = 0.4 * parent_radius * parent_radius * parent_radius * parent_radius *
-                        parent_radius;
+  const double parent =
+      0.4 * parent_radius * parent_radius * parent_radius * parent_radius * parent_radius;
   if (spread > 0.0 && own + spread > parent) {
     const double s = own < parent ? std::sqrt((parent - own) / spread) : 0.0;
     for (Offset& x : o) x = {s * x.x, s * x.y};

@@ -7,9 +7,9 @@
 #include <limits>
 #include <numbers>
 
+#include "core/base/errors.hpp"
 #include "core/base/random.hpp"
 #include "core/contact/contact_models.hpp"
-#include "core/base/errors.hpp"
 #include "core/geometry/drum_geometry.hpp"
 #include "core/geometry/walls.hpp"
 #include "core/mill/breakage_laws.hpp"
@@ -324,8 +324,7 @@ void Grinding::break_parents(double time, const std::vector<Parent>& parents, Pa
         record.fines_mass = g.fines_mass;
         if (g.fines_mass > 0.0) {
           // The fines: a point mass at the parent's centre with its velocity, out at once.
-          ledger.discharged +=
-              g.fines_mass * (0.5 * norm2(q.v) - dot(scene_.run.gravity, q.x));
+          ledger.discharged += g.fines_mass * (0.5 * norm2(q.v) - dot(scene_.run.gravity, q.x));
           sizes_.product.add_fines(g.fines_mass, g.fines_law_mass,
                                    std::min(b.fines_diameter, 2.0 * q.radius), g.alpha);
           fines += g.fines_mass;
@@ -481,9 +480,7 @@ void Grinding::exclude_births(ContactEngine& contacts) const {
 
 std::vector<BreakageRecord> Grinding::take_breakages() { return std::exchange(breakages_, {}); }
 std::vector<ProductRecord> Grinding::take_product() { return std::exchange(product_, {}); }
-std::vector<FragmentRecord> Grinding::take_fragments() {
-  return std::exchange(fragment_log_, {});
-}
+std::vector<FragmentRecord> Grinding::take_fragments() { return std::exchange(fragment_log_, {}); }
 
 void combine(SizeMasses& m, const Domain& domain) {
   domain.sum(m.units());

@@ -34,8 +34,8 @@
 #include <vector>
 
 #include "core/base/scene.hpp"
-#include "core/mill/size_classes.hpp"
 #include "core/contact/contact_engine.hpp"
+#include "core/mill/size_classes.hpp"
 #include "core/shape/particles.hpp"
 #include "core/step/domain.hpp"
 #include "core/step/energy_ledger.hpp"
@@ -61,7 +61,7 @@ struct BreakageRecord {
   std::int64_t parent = 0;
   double radius = 0.0, energy = 0.0;  // the parent's share of the breaking loading's peak (J)
   int fragments = 0;
-  std::int64_t first_id = 0;  // the fragments' ids: first_id, first_id + 1, ...
+  std::int64_t first_id = 0;                 // the fragments' ids: first_id, first_id + 1, ...
   double mass = 0.0, specific_energy = 0.0;  // kg; J/kg: energy / mass
   double t10 = 0.0;                          // % of the progeny's mass below a tenth of 2 radius
   double fines_mass = 0.0;                   // kg
@@ -123,9 +123,7 @@ class Grinding {
   std::int64_t next_id() const { return next_id_; }
   // Checkpoints: the state after a step (records already taken), and the same put back (the
   // product's sizes as a checkpoint holds them: summed, on rank 0).
-  GrindingState state() const {
-    return {next_id_, births_from_, next_feed_try_, totals_, sizes_};
-  }
+  GrindingState state() const { return {next_id_, births_from_, next_feed_try_, totals_, sizes_}; }
   void restore(const GrindingState& s) {
     next_id_ = s.next_id;
     births_from_ = s.births_from;

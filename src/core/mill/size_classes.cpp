@@ -13,8 +13,7 @@ double SizeMasses::edge(int k) {
 
 int SizeMasses::size_class(double diameter) {
   if (!(diameter >= edge(0))) return 0;
-  int k = std::clamp(static_cast<int>(std::floor(4.0 * std::log2(diameter / 1e-6))) + 1, 1,
-                     kEdges);
+  int k = std::clamp(static_cast<int>(std::floor(4.0 * std::log2(diameter / 1e-6))) + 1, 1, kEdges);
   // The floating log may land one class off next to an edge: the edges decide.
   while (k > 1 && diameter < edge(k - 1)) --k;
   while (k < kEdges && diameter >= edge(k)) ++k;
@@ -111,7 +110,8 @@ double SizeMasses::passing_size(double percent) const {
       // Within class k, between the smallest and the largest size put in it, linear in log.
       const double f = (target - static_cast<double>(below)) /
                        static_cast<double>(units_[static_cast<std::size_t>(k)]);
-      const double lo = -neg_low_[static_cast<std::size_t>(k)], hi = high_[static_cast<std::size_t>(k)];
+      const double lo = -neg_low_[static_cast<std::size_t>(k)],
+                   hi = high_[static_cast<std::size_t>(k)];
       if (!(lo > 0.0)) return f * hi;
       return lo * std::pow(hi / lo, f);
     }
