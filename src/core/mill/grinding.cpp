@@ -291,61 +291,18 @@ void Grinding::break_parents(double time, const std::vector<Parent>& parents, Pa
       mine_counts.push_back(fragment_count(q.id));
     }
   }
-  std::vector<std::int64_t> all = domain.allgather(mine_counts);
+  const std::vector<std::int64_t> all = domain.allgather(mine_counts);
   std::vector<std::pair<std::int64_t, std::int64_t>> order;
   for (std::size_t k = 0; k + 1 < all.size(); k += 2) order.emplace_back(all[k], all[k + 1]);
   std::sort(order.begin(), order.end());
   std::int64_t id = next_id_;
-  const std::uint64_t seed = stream(scene_.run.seed, kStreamFragments);
   double fines = 0.0;
   for (const auto& [parent_id, count] : order) {
     const int n = static_cast<int>(count);
     const auto it = std::find(mine.begin(), mine.end(), parent_id);
     if (it != mine.end()) {
       const std::size_t k = static_cast<std::size_t>(it - mine.begin());
-      const Parent& q = parents[k];
-      const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
-      const double mass = Disc::mass(q.radius, density);
-      const double turn =
-          2.0 * std::numbers::pi * random_uniform(seed, static_cast<std::uint64_t>(q.id), 1);
-      BreakageRecord record{time, q.id, q.radius, q.energy, n, id, mass, q.energy / mass};
-      const auto born = [&](std::int64_t fid, double r_f, Vec2 offset) {
-        p.add(fid, q.material, r_f, density, q.x + offset,
-              q.v + q.omega * Vec2{-offset.y, offset.x}, q.omega);
-        fragment_log_.push_back({time, q.id, fid, r_f, Disc::mass(r_f, density)});
-      };
-      if (b.fragments == FragmentLaw::kT10) {
-        const Progeny& g = progeny[k];
-        const std::vector<Offset> at = fragment_offsets(q.radius, g.radii, turn);
-        for (int f = 0; f < n; ++f) {
-          const std::size_t fk = static_cast<std::size_t>(f);
-          born(id + f, g.radii[fk], Vec2{at[fk].x, at[fk].y});
-        }
-        record.fines_mass = g.fines_mass;
-        if (g.fines_mass > 0.0) {
-          // The fines: a point mass at the parent's centre with its velocity, out at once.
-          ledger.discharged += g.fines_mass * (0.5 * norm2(q.v) - dot(scene_.run.gravity, q.x));
-          sizes_.product.add_fines(g.fines_mass, g.fines_law_mass,
-                                   std::min(b.fines_diameter, 2.0 * q.radius), g.alpha);
-          fines += g.fines_mass;
-        }
-        // t10 as the progeny gives it: the fragments below a tenth plus the fines there.
-        double below = 0.0;
-        for (const double r_f : g.radii)
-          if (2.0 * r_f < 0.2 * q.radius) below += Disc::mass(r_f, density);
-        const double tenth = 0.2 * q.radius;
-        below += tenth >= b.fines_diameter
-                     ? g.fines_mass
-                     : g.fines_law_mass * std::pow(tenth / b.fines_diameter, g.alpha);
-        record.t10 = 100.0 * below / mass;
-      } else {
-        const double r_f = q.radius / std::cbrt(static_cast<double>(n));
-        for (int f = 0; f < n; ++f) {
-          const double a = turn + 2.0 * std::numbers::pi * f / n;
-          born(id + f, r_f, (q.radius - r_f) * Vec2{std::cos(a), std::sin(a)});
-        }
-      }
-      breakages_.push_back(record);
+      fines += bear(time, parents[k], n, id, progeny[k], p, ledger);
     }
     id += n;
     totals_.breakages += 1;
@@ -357,6 +314,55 @@ void Grinding::break_parents(double time, const std::vector<Parent>& parents, Pa
     totals_.fines_mass += all_fines;
     totals_.discharged_mass += all_fines;
   }
+}
+
+// Parent q's n fragments, ids from `first` (its progeny g for t10, else n equal spheres), put
+// into the store and the logs; returns the mass of its fines, which leave at once.
+double Grinding::bear(double time, const Parent& q, int n, std::int64_t first, const Progeny& g,
+                      ParticleStore& p, EnergyLedger& ledger) {
+  const BreakageSpec& b = scene_.breakage;
+  const double density = scene_.materials[static_cast<std::size_t>(q.material)].density;
+  const double mass = Disc::mass(q.radius, density);
+  const double turn = 2.0 * std::numbers::pi *
+                      random_uniform(stream(scene_.run.seed, kStreamFragments),
+                                     static_cast<std::uint64_t>(q.id), 1);
+  BreakageRecord record{time, q.id, q.radius, q.energy, n, first, mass, q.energy / mass};
+  const auto born = [&](std::int64_t fid, double r_f, Vec2 offset) {
+    p.add(fid, q.material, r_f, density, q.x + offset, q.v + q.omega * Vec2{-offset.y, offset.x},
+          q.omega);
+    fragment_log_.push_back({time, q.id, fid, r_f, Disc::mass(r_f, density)});
+  };
+  if (b.fragments == FragmentLaw::kEqual) {
+    const double r_f = q.radius / std::cbrt(static_cast<double>(n));
+    for (int f = 0; f < n; ++f) {
+      const double a = turn + 2.0 * std::numbers::pi * f / n;
+      born(first + f, r_f, (q.radius - r_f) * Vec2{std::cos(a), std::sin(a)});
+    }
+    breakages_.push_back(record);
+    return 0.0;
+  }
+  const std::vector<Offset> at = fragment_offsets(q.radius, g.radii, turn);
+  for (int f = 0; f < n; ++f) {
+    const auto fk = static_cast<std::size_t>(f);
+    born(first + f, g.radii[fk], Vec2{at[fk].x, at[fk].y});
+  }
+  record.fines_mass = g.fines_mass;
+  if (g.fines_mass > 0.0) {
+    // The fines: a point mass at the parent's centre with its velocity, out at once.
+    ledger.discharged += g.fines_mass * (0.5 * norm2(q.v) - dot(scene_.run.gravity, q.x));
+    sizes_.product.add_fines(g.fines_mass, g.fines_law_mass,
+                             std::min(b.fines_diameter, 2.0 * q.radius), g.alpha);
+  }
+  // t10 as the progeny gives it: the fragments below a tenth of the size plus the fines there.
+  const double tenth = 0.2 * q.radius;
+  double below = tenth >= b.fines_diameter
+                     ? g.fines_mass
+                     : g.fines_law_mass * std::pow(tenth / b.fines_diameter, g.alpha);
+  for (const double r_f : g.radii)
+    if (2.0 * r_f < tenth) below += Disc::mass(r_f, density);
+  record.t10 = 100.0 * below / mass;
+  breakages_.push_back(record);
+  return g.fines_mass;
 }
 
 bool Grinding::in_zone(Vec2 x) const {

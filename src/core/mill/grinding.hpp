@@ -35,6 +35,7 @@
 
 #include "core/base/scene.hpp"
 #include "core/contact/contact_engine.hpp"
+#include "core/mill/breakage_laws.hpp"
 #include "core/mill/size_classes.hpp"
 #include "core/shape/particles.hpp"
 #include "core/step/domain.hpp"
@@ -175,6 +176,8 @@ class Grinding {
   int fragment_count(std::int64_t parent) const;
   void break_parents(double time, const std::vector<Parent>& parents, ParticleStore& p,
                      Domain& domain, EnergyLedger& ledger);
+  double bear(double time, const Parent& q, int n, std::int64_t first, const Progeny& g,
+              ParticleStore& p, EnergyLedger& ledger);
   double share(int material, int partner_material) const;
   bool in_zone(Vec2 x) const;  // the box or the grate ring
   void discharge(double time, const ParticleStore& p, Domain& domain);
