@@ -890,11 +890,13 @@ inline constexpr Key<BreakageSpec> kBreakageKeys[] = {
      .unit = "J",
      .range = kNonNegative,
      .field = member<&BreakageSpec::minimum_energy>(),
+     .written_if = [](const BreakageSpec& b) { return b.model == BreakageModel::kThesis; },
      .doc = "thesis model: E_min, a share below it does no damage (thesis T34, Table 1)"},
     {.name = "strength",
      .unit = "1/J",
      .range = kPositive,
      .field = member<&BreakageSpec::strength>(),
+     .written_if = [](const BreakageSpec& b) { return b.model == BreakageModel::kThesis; },
      .doc = "thesis model: S in the breakage probability P = 1 - exp(-S E_t), E_t = damage + E "
             "- E_min (thesis T36, Table 1)"},
     {.name = "f_mat",

@@ -557,7 +557,7 @@ TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
   s.sieve.material = "ore";
   s.sieve.box_min = {-0.05, -0.05};
   s.sieve.box_max = {0.05, 0.05};
-  s.sieve.aperture = 0.008;
+  s.sieve.aperture = 0.016;  // a diameter
   const std::size_t initial = static_cast<std::size_t>(Simulation(s).particles().n_owned());
   expect_same_as_serial(s, 12000, 2000, [initial](const Simulation& ser) {
     const SeriesRow r = ser.diagnostics();
