@@ -106,5 +106,36 @@ TEST(Resume, GrindingContinuesBitForBitThroughBreakageFeedAndSieve) {
   check_resume(s, 0.3, 0.6);
 }
 
+// The size-aware ore: damage in J/kg, t10 progeny and their fines, the grate; the size
+// distributions (feed, product) continue too.
+TEST(Resume, SizeAwareOreContinuesBitForBitWithItsSizes) {
+  Scene s = testing_support::grinding_drum_scene();
+  BreakageSpec& b = s.breakage;
+  b.model = BreakageModel::kVogelPeukert;
+  b.f_mat = 50.0;
+  b.xw_min = 0.01;
+  b.fragments = FragmentLaw::kT10;
+  b.t10_a = 60.0;
+  b.t10_b = 30.0;
+  b.fines_diameter = 0.02;
+  Simulation original(s);
+  original.run_until(0.3);
+  ASSERT_GT(original.grinding()->totals().breakages, 0);
+  ASSERT_GT(original.grinding()->totals().fines_mass, 0.0);
+  check_resume(s, 0.3, 0.6);
+  Simulation again(s);
+  again.run_until(0.3);
+  const Resumption r = resumption_of(again);
+  Simulation resumed(s, nullptr, &r);
+  again.run_until(0.6);
+  resumed.run_until(0.6);
+  const GrindingSizes x = again.grinding()->state().sizes, y = resumed.grinding()->state().sizes;
+  for (int k = 0; k < SizeMasses::kClasses; ++k) {
+    EXPECT_EQ(x.fed.units()[k], y.fed.units()[k]);
+    EXPECT_EQ(x.product.units()[k], y.product.units()[k]);
+  }
+  EXPECT_GT(x.product.total_kg(), 0.0);
+}
+
 }  // namespace
 }  // namespace dem2d

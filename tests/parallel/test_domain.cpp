@@ -511,7 +511,7 @@ TEST(Reproducibility, PackingInContactFromTheFirstStep) {
 // Ore breaking all over a drum filled to its centre (where every wedge meets), so that fragments
 // are born across sector boundaries and at the centre, with feed and a sieve at the centre:
 // ids, births, removals and every particle's state the same on every rank count.
-TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
+Scene ore_across_sectors() {
   Scene s;
   s.title = "ore breaking, feed and sieve, whole drum, centre filled";
   s.deck_path = "test_domain";
@@ -558,6 +558,11 @@ TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
   s.sieve.box_min = {-0.05, -0.05};
   s.sieve.box_max = {0.05, 0.05};
   s.sieve.aperture = 0.016;  // a diameter
+  return s;
+}
+
+TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
+  Scene s = ore_across_sectors();
   const std::size_t initial = static_cast<std::size_t>(Simulation(s).particles().n_owned());
   expect_same_as_serial(s, 12000, 2000, [initial](const Simulation& ser) {
     const SeriesRow r = ser.diagnostics();
@@ -569,6 +574,31 @@ TEST(Reproducibility, OreBreakingAcrossSectorsAndAtTheCentre) {
     for (std::size_t k = 0; k < p.n_owned(); ++k)
       near_centre += p.id[k] >= static_cast<std::int64_t>(initial) && norm(p.pos[k]) < 0.05;
     EXPECT_GT(near_centre, 0) << "no fragment or fed particle near the centre";
+  });
+}
+
+// The size-aware ore: Vogel-Peukert breakage on each body's compliance share, t10 progeny whose
+// counts only the parent's owner knows and whose fines leave at once, and an overflow that lets
+// out the finest ore above a hold-up (an exact integer sum over ranks): the same bits on every
+// rank count.
+TEST(Reproducibility, SizeAwareOreWithT10ProgenyAndOverflow) {
+  Scene s = ore_across_sectors();
+  s.title = "Vogel-Peukert ore, t10 progeny, overflow";
+  BreakageSpec& b = s.breakage;
+  b.model = BreakageModel::kVogelPeukert;
+  b.f_mat = 400.0;
+  b.xw_min = 0.001;
+  b.fragments = FragmentLaw::kT10;
+  b.t10_a = 60.0;
+  b.t10_b = 50.0;
+  b.fines_diameter = 0.012;  // the smallest fragment as in the thesis variant: the same dt
+  s.sieve.type = DischargeType::kOverflow;
+  s.sieve.holdup = 0.97 * Simulation(s).diagnostics().ore_mass;
+  expect_same_as_serial(s, 12000, 2000, [](const Simulation& ser) {
+    const GrindingTotals& t = ser.grinding()->totals();
+    EXPECT_GE(t.breakages, 10);
+    EXPECT_GT(t.fines_mass, 0.0);
+    EXPECT_GT(t.discharged_count, 0);
   });
 }
 
