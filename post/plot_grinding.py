@@ -482,8 +482,8 @@ def plot(outdir, figures, data, out):
     plot_masses(ax[1, 1], series, figures, data["balance_error"])
     plot_rates(ax[2, 0], series, figures)
     plot_figures(ax[2, 1], figures)
-    fig.suptitle(millplot.run_title(run, f"ore scene in {os.path.basename(outdir)}"),
-                 fontsize=11)
+    title = millplot.run_title(run, f"ore scene in {os.path.basename(outdir)}")
+    fig.suptitle("\n".join(textwrap.wrap(title, 130)), fontsize=11)
     fig.tight_layout()
     fig.savefig(out, dpi=100)
     plt.close(fig)
