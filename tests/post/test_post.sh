@@ -1,14 +1,15 @@
 #!/bin/bash
-# The mill post-processing scripts on a short real run: post/report.py, post/plot_series.py and
+# The mill post-processing scripts on short real runs: post/report.py, post/plot_series.py and
 # post/sweep.py exit 0, write every file they promise as a real picture (a PNG of some size with
 # more than a few colours), and what they print agrees with series.csv read independently here
-# (mean power, regime, critical speed; the sweep's speeds and powers).
+# (mean power, regime, critical speed; the sweep's speeds and powers); post/plot_grinding.py on
+# a short grinding run, its figures against product.csv, breakages.csv, series.csv and run.json.
 #
 #   tests/post/test_post.sh [DEM2D [SOURCE_DIR]]
 #
 # DEM2D defaults to SOURCE_DIR/build/src/dem2d, SOURCE_DIR to this script's repository. Uses
 # /usr/bin/python3 (numpy, matplotlib, h5py). Everything is written in a temporary folder that
-# is removed at the end. About 20-40 s on two busy cores.
+# is removed at the end. About 40-60 s on two busy cores.
 set -u
 
 source_dir=${2:-$(cd "$(dirname "$0")/../.." && pwd)}
@@ -273,6 +274,151 @@ check "every PNG is a real picture (report, made-up spectra, plot_series, sweep)
   "$sweep/power_vs_speed.png"
 if grep -qE "^ +0\.9 .*kW/m|^ +0\.9 " "$work/sweep.log"; then pass "sweep.py printed its table"
 else fail "sweep.py printed no table row for 0.9"; sed -n '1,20p' "$work/sweep.log"; fi
+
+# --- plot_grinding.py on a real grinding run ------------------------------------------------------
+# The grate-discharge deck for 2 s with a weak ore that starts breaking at 0.2 s: breakage,
+# fines and discharge all happen (about 10 s on two busy cores at np 2). What plot_grinding.py
+# prints and writes as JSON is checked against product.csv, breakages.csv, series.csv and
+# run.json read here.
+grind=$work/grind
+grind_start=$SECONDS
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+launch=(mpirun -np 2)
+if ! command -v mpirun >/dev/null; then
+  launch=()
+  echo "note: no mpirun on the PATH: the grinding run on one rank"
+fi
+check "dem2d: a 2 s grate-discharge grinding run (np 2)" \
+  "${launch[@]}" "$dem2d" "$source_dir/inputs/grinding_grate.in" --output "$grind" --overwrite \
+  --quiet --set run.duration=2.0 --set breakage.f_mat=1.5 --set breakage.start=0.2 \
+  --set drum.ramp_time=0.2 --set output.snapshot_interval=0.25
+echo "note: the grinding run took $((SECONDS - grind_start)) s"
+# plot_grinding.py with the default window and with --window 0.5: its output kept for the checks.
+for w in third 0.5; do
+  opts=()
+  if [ "$w" != third ]; then opts=(--window "$w"); fi
+  if "$py" "$post/plot_grinding.py" "$grind" -o "$work/grinding_$w.png" "${opts[@]}" \
+    --json "$work/grinding_$w.json" >"$work/grinding_$w.txt" 2>&1; then
+    pass "plot_grinding.py OUTDIR ${opts[*]:-(default window)} --json FILE exits 0"
+  else
+    fail "plot_grinding.py OUTDIR ${opts[*]:-} --json FILE exited non-zero"
+    sed -n '1,15p' "$work/grinding_$w.txt"
+  fi
+done
+check "grinding PNGs are real pictures" png_ok "$work/grinding_third.png" "$work/grinding_0.5.png"
+# grinding_check WINDOW: the printed lines and the JSON against the run's files read here.
+grinding_check() {
+  "$py" - "$grind" "$work/grinding_$1.txt" "$work/grinding_$1.json" "$1" <<'EOF'
+import csv, json, re, sys
+run_dir, printed_path, json_path, window = sys.argv[1:5]
+text = open(printed_path, encoding="utf-8").read()
+assert "warning" not in text, text
+printed = dict(re.findall(r"^(\w+) = (\S+)", text, re.M))
+mine = json.load(open(json_path, encoding="utf-8"))
+run = json.load(open(f"{run_dir}/run.json", encoding="utf-8"))
+g = run["grinding"]
+
+
+def rows(name):
+    return list(csv.DictReader(open(f"{run_dir}/{name}", encoding="ascii")))
+
+
+def close(a, b, rel=1e-9):
+    return abs(a - b) <= rel * max(abs(a), abs(b))
+
+
+def same(key, value, rel=1e-9):
+    """The printed figure (10 digits) and the JSON one both equal `value`."""
+    assert key in printed and key in mine, (key, sorted(printed))
+    assert close(float(printed[key]), value, max(rel, 1e-9)), (key, printed[key], value)
+    assert close(mine[key], value, rel), (key, mine[key], value)
+
+
+product, breakages, series = rows("product.csv"), rows("breakages.csv"), rows("series.csv")
+# The run ground: ore broke, fines went out with the product, particles were discharged.
+fines = sum(float(r["fines_mass"]) for r in breakages)
+assert len(breakages) > 0 and fines > 0 and len(product) > 0, (len(breakages), fines)
+# Breakages: breakages.csv's rows = series.csv's count = run.json's.
+assert len(breakages) == int(float(series[-1]["breakages"])) == run["ore"]["breakages"]
+same("breakages", len(breakages), 0.0)
+# Product: product.csv + the fines = run.json's product mass = series' last discharged_mass.
+mass = sum(float(r["mass"]) for r in product) + fines
+assert close(mass, g["product_mass_kg"]), (mass, g["product_mass_kg"])
+assert close(mass, float(series[-1]["discharged_mass"])), mass
+same("product_mass_kg", mass)
+# F80, P80, reduction ratio: run.json's, each in the class of sizes.csv where its stream
+# crosses 80 % passing.
+for key in ("f80_m", "p80_m", "reduction_ratio"):
+    same(key, g[key], 0.0)
+    assert float(printed[key]) == g[key], (key, printed[key], g[key])
+sizes = rows("sizes.csv")
+for key, stream in (("f80_m", "fed"), ("p80_m", "product")):
+    k = next(i for i, r in enumerate(sizes) if float(r[f"{stream}_passing"]) >= 80.0)
+    low = float(sizes[k - 1]["diameter"]) if k else 0.0
+    assert low <= g[key] <= float(sizes[k]["diameter"]) * (1 + 1e-6), (key, g[key], low)
+# The window: the last third of the run (or --window S); its first row the first at or after
+# t_end - S; rates and power from the differences between its first and last rows.
+t = [float(r["time"]) for r in series]
+span = float(window) if window != "third" else (t[-1] - t[0]) / 3
+r0 = next(i for i, x in enumerate(t) if x >= t[-1] - span)
+dt = t[-1] - t[r0]
+
+
+def col(name):
+    return [float(r[name]) for r in series]
+
+
+feed = (col("fed_mass")[-1] - col("fed_mass")[r0]) / dt
+discharge = (col("discharged_mass")[-1] - col("discharged_mass")[r0]) / dt
+power = (col("drum_work")[-1] - col("drum_work")[r0]) / dt
+hold = col("ore_mass")[r0:]
+middle = (t[r0] + t[-1]) / 2
+first = [m for x, m in zip(t[r0:], hold) if x < middle]
+second = [m for x, m in zip(t[r0:], hold) if x >= middle]
+change = (sum(second) / len(second) - sum(first) / len(first)) / (sum(first) / len(first))
+assert discharge > 0 and feed > 0 and power > 0, (feed, discharge, power)
+same("window_feed_rate_kg_s", feed)
+same("window_discharge_rate_kg_s", discharge)
+same("window_holdup_mean_kg", sum(hold) / len(hold))
+same("window_holdup_change", change)
+same("window_power_W", power)
+same("window_specific_energy_kwh_per_t", power / discharge / 3600)
+# Every kWh/t figure is printed with run.json's note beside it.
+note = g["specific_energy_note"]
+kwh = [line for line in text.splitlines() if "kWh/t" in line]
+assert len(kwh) >= 2 and all(note in line for line in kwh), kwh
+assert mine["specific_energy_note"] == note
+print(f"product {mass:.6g} kg, P80 {g['p80_m']:.4g} m, window {dt:.3g} s: feed {feed:.4g} "
+      f"kg/s, discharge {discharge:.4g} kg/s, {power / discharge / 3600:.4g} kWh/t")
+EOF
+}
+check "plot_grinding.py's figures agree with the run's files (the last third of the run)" \
+  grinding_check third
+check "plot_grinding.py's figures agree with the run's files (--window 0.5)" grinding_check 0.5
+# The ore by its name: run.json's [breakage] material found in snapshots.h5's /materials (the
+# real run: 'ore' is material 1), else in run.json's material list, else [feed]'s, [sieve]'s;
+# series.csv's regime kept as words.
+check "plot_grinding.py: the ore by name, the regime as words" "$py" - "$post" "$grind" <<'EOF'
+import copy, json, sys
+sys.path.insert(0, sys.argv[1])
+import plot_grinding
+d = sys.argv[2]
+run = json.load(open(f"{d}/run.json", encoding="utf-8"))
+assert plot_grinding.ore_material(run, f"{d}/snapshots.h5")[:2] == (1, "ore")
+swapped = copy.deepcopy(run)
+swapped["deck"]["material"].reverse()  # without snapshots: the deck's order
+assert plot_grinding.ore_material(swapped, None)[:2] == (0, "ore")
+swapped["deck"]["breakage"]["material"] = "steel"  # the breakage material comes first
+assert plot_grinding.ore_material(swapped, None)[:2] == (1, "steel")
+del swapped["deck"]["breakage"], swapped["deck"]["feed"]  # the sieve's material
+assert plot_grinding.ore_material(swapped, None)[:2] == (0, "ore")
+del swapped["deck"]["sieve"]
+assert plot_grinding.ore_material(swapped, None)[0] is None
+s = plot_grinding.read_csv(f"{d}/series.csv")
+assert s["regime"].dtype.kind == "U" and s["time"].dtype.kind == "f"
+assert "cataracting" in set(s["regime"]), set(s["regime"])
+EOF
+echo "note: the grinding section took $((SECONDS - grind_start)) s"
 
 echo "post-processing tests: $((SECONDS - start)) s"
 echo "$passed passed, $failed failed"
