@@ -132,6 +132,10 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   for (const std::string& s : facts.overrides)
     sets += (sets.empty() ? "" : ", ") + quoted_string(s);
   extra.add("overrides", "[" + sets + "]");
+  std::string warnings;
+  for (const std::string& w : facts.warnings)
+    warnings += (warnings.empty() ? "" : ", ") + quoted_string(w);
+  extra.add("warnings", "[" + warnings + "]");
   return info;
 }
 

@@ -22,6 +22,7 @@ struct RunFacts {
   bool interrupted = false;     // stopped by SIGINT or SIGTERM
   std::string restarted_from;   // the checkpoint continued (--restart), empty for a new run
   std::vector<std::string> overrides;  // the --set options, in order
+  std::vector<std::string> warnings;   // what the run warned of while it ran
 };
 
 // Collective (the decomposition's per-rank figures and the mill's totals are gathered).

@@ -1,5 +1,6 @@
 #include "io/run_loop.hpp"
 
+#include <fmt/format.h>
 #include <signal.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "core/base/errors.hpp"
+#include "core/mill/mill_analytics.hpp"
 #include "io/checkpoint.hpp"
 #include "io/collisions.hpp"
 #include "io/output_dir.hpp"
@@ -130,9 +132,27 @@ void RunLoop::after_step() {
     series_.write(sim_.record_row());
     ore_.write(sim_);
     sim_.reset_pass_window();
+    watch_fill();
   }
   if (due.snapshot) snapshot();
   if (due.checkpoint) checkpoint();
+}
+
+void RunLoop::watch_fill() {
+  if (fill_told_ || !scene_.feed.present || !scene_.drum.present) return;
+  const ParticleStore& p = sim_.particles();
+  double area = 0.0;
+  for (std::size_t k = 0; k < p.n_owned(); ++k) area += p.radius[k] * p.radius[k];
+  const double r = scene_.drum.radius;
+  const double j = domain_.sum(area) / (r * r) / kBedPacking;
+  if (j <= kFillWarning) return;
+  fill_told_ = true;
+  warnings_.push_back(fmt::format(
+      "at t = {:.4g} s the charge fills the drum to a bed filling of {:.3f} (above {}): the feed "
+      "({}) brings in more than the discharge lets out; a lower feed rate, a wider aperture or "
+      "a faster breakage keeps the mill in its range",
+      sim_.time(), j, kFillWarning, scene_.feed.period > 0.0 ? "feed.period" : "feed.mass_rate"));
+  say(scene_.deck_path + ": warning: " + warnings_.back() + "\n", stderr);
 }
 
 bool RunLoop::stop_requested() {

@@ -5,6 +5,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "core/run/simulation.hpp"
 #include "core/step/domain.hpp"
@@ -40,6 +42,11 @@ class RunLoop {
   // run() returns, as of the last poll while it runs.
   std::int64_t particles() const { return particles_; }
   std::int64_t particle_steps() const { return particle_steps_; }
+  // The warnings the run gave while it ran (told on stderr too), for run.json.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  // Above this bed filling a fed mill is told that its charge is filling the drum (the charge
+  // then reaches past the drum centre: no mill runs so full).
+  static constexpr double kFillWarning = 0.5;
 
  private:
   // The outputs due at time t: one test for the step that acts on them (after_step, finish)
@@ -65,6 +72,9 @@ class RunLoop {
   // steps since.
   double particle_steps_now() const;
   Ending finish(Ending ending);
+  // Collective, at series rows of a fed drum: the warning, once, when the bed filling passes
+  // kFillWarning.
+  void watch_fill();
 
   Simulation& sim_;
   const Scene& scene_;
@@ -80,6 +90,8 @@ class RunLoop {
   int stop_signal_ = 0;
   std::int64_t local_particle_steps_ = 0;  // this rank's owned particles summed over the steps
   std::int64_t particles_ = 0, particle_steps_ = 0, counted_at_step_ = 0;
+  std::vector<std::string> warnings_;
+  bool fill_told_ = false;
 };
 
 }  // namespace dem2d

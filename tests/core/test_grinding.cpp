@@ -440,8 +440,8 @@ TEST(Grinding, VogelPeukertBreaksEachSizeAtItsProbability) {
     const double p = 1.0 - std::exp(-20.0 * 2.0 * r * damage);
     const double fraction = static_cast<double>(breaks.size()) / n;
     EXPECT_EQ(survivors + static_cast<int>(breaks.size()), n);
-    EXPECT_NEAR(fraction, p, 4.0 * std::sqrt(p * (1.0 - p) / n)) << "r = " << r << ", W - W_min = "
-                                                                   << damage << " J/kg";
+    EXPECT_NEAR(fraction, p, 4.0 * std::sqrt(p * (1.0 - p) / n))
+        << "r = " << r << ", W - W_min = " << damage << " J/kg";
     EXPECT_GT(fraction, last);
     last = fraction;
   }
