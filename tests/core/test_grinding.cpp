@@ -1,4 +1,4 @@
-// Grinding (docs/models.md, "Grinding: breakage, feed, sieve"; thesis T34-T36): the breakage
+// Grinding (docs/models.md, "Grinding"; thesis T34-T36): the breakage
 // law's statistics, the fragment law, conservation at a break, the sieve and the feed.
 #include <gtest/gtest.h>
 
