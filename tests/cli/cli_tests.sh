@@ -45,14 +45,40 @@ grinding_run() {
     "$src/inputs/grinding.in" --set run.duration=1.6 --set output.snapshot_interval=0.4 --output "$tmp/gr$1"
 }
 
+# same_logs A B: the ore logs and the size distributions of two runs, byte for byte.
+same_logs() {
+  local f
+  for f in breakages.csv fragments.csv product.csv sizes.csv; do cmp -s "$1/$f" "$2/$f" || return 1; done
+}
+
+# size_aware_ranks: the size-aware ore (Vogel-Peukert, t10 progeny and fines, the grate) on 1 and
+# 3 ranks: snapshots and logs identical; fines made and ore let out through the grate.
+size_aware_ranks() {
+  local np
+  for np in 1 3; do
+    expect "size-aware grinding np$np" 0 'done: 0.6 s simulated' -- mpirun -np "$np" --oversubscribe \
+      "$dem2d" "$src/inputs/grinding_grate.in" --set run.duration=0.6 --set breakage.start=0.0 \
+      --set breakage.f_mat=20 --set drum.ramp_time=0.1 --set output.snapshot_interval=0.2 \
+      --output "$tmp/sa$np"
+  done
+  expect "size-aware grinding np3 snapshots identical to np1" 0 'bit-identical' -- /usr/bin/python3 \
+    "$src/post/h5compare.py" "$tmp/sa1/snapshots.h5" "$tmp/sa3/snapshots.h5"
+  same_logs "$tmp/sa1" "$tmp/sa3" && pass "size-aware grinding np3 logs identical" ||
+    fail "size-aware grinding np3 logs differ"
+  expect "size-aware grinding: fines and grate discharge" 0 'ok' -- /usr/bin/python3 -c "
+import json
+g = json.load(open('$tmp/sa3/run.json'))
+o, r = g['ore'], g['grinding']
+print('ok' if o['fines_mass_kg'] > 0 and o['discharged_count'] > 0 and r['p80_m'] < 0.06 else 'bad', o, r['p80_m'])"
+}
+
 # grinding_alike: the runs on 2 and 3 ranks against the run on 1, and the mass balance.
 grinding_alike() {
   local np
   for np in 2 3; do
     expect "grinding np$np snapshots identical to np1" 0 'bit-identical' -- /usr/bin/python3 \
       "$src/post/h5compare.py" "$tmp/gr1/snapshots.h5" "$tmp/gr$np/snapshots.h5"
-    cmp -s "$tmp/gr1/breakages.csv" "$tmp/gr$np/breakages.csv" && cmp -s "$tmp/gr1/product.csv" \
-      "$tmp/gr$np/product.csv" && pass "grinding np$np logs identical" || fail "grinding np$np logs differ"
+    same_logs "$tmp/gr1" "$tmp/gr$np" && pass "grinding np$np logs identical" || fail "grinding np$np logs differ"
   done
   expect "grinding breaks, feeds and sieves" 0 'ok' -- /usr/bin/python3 -c "
 import csv, sys
@@ -343,6 +369,7 @@ job_init "$tmp/jobs"
 # Grinding first: it is the longest job by far (its 2- and 3-rank runs most of all) and the
 # others together fit beside it. The rest in the order of this file.
 job "grinding on 1, 2, 3 ranks" grinding_ranks
+job "size-aware grinding on 1, 3 ranks" size_aware_ranks
 job "bad input, 1 rank" bad_input 1
 job "bad input, 2 ranks" bad_input 2
 job "--check" check_decks

@@ -116,13 +116,13 @@ same_series "iterative 2 -> 1 series.csv (passes column included)" "$tmp/it_ref"
 # --- Grinding: breakage, feed and sieve across the restart -------------------------------------
 gr=("$src/inputs/grinding.in" --quiet --set run.duration=0.4 --set breakage.start=0.0
     --set breakage.minimum_energy=0.001 --set breakage.strength=20 --set feed.start=0.0
-    --set feed.period=0.02 --set sieve.aperture=0.06)
+    --set feed.period=0.02 --set sieve.aperture=0.12 --set breakage.minimum_radius=0.06)
 on 1 "${gr[@]}" --output "$tmp/gr_ref"
 on 1 "${gr[@]}" --output "$tmp/gr_part" --set run.duration=0.25
 on 2 "${gr[@]}" --output "$tmp/gr_part" --restart "$tmp/gr_part/checkpoint.h5"
 same_particles "grinding 1 -> 2 particles" "$tmp/gr_ref" "$tmp/gr_part"
 same_series "grinding 1 -> 2 series.csv (ore columns exact)" "$tmp/gr_ref" "$tmp/gr_part"
-for log in breakages.csv product.csv; do
+for log in breakages.csv fragments.csv product.csv sizes.csv; do
   rows=$(($(wc -l <"$tmp/gr_ref/$log") - 1))
   if cmp -s "$tmp/gr_ref/$log" "$tmp/gr_part/$log"; then pass "grinding 1 -> 2 $log identical ($rows rows)"
   else fail "grinding 1 -> 2 $log differs"; diff "$tmp/gr_ref/$log" "$tmp/gr_part/$log" | head -4; fi
@@ -130,6 +130,30 @@ done
 after=$(awk -F, 'NR > 1 && $1 > 0.25' "$tmp/gr_ref/breakages.csv" | wc -l)
 if [ "$after" -gt 0 ]; then pass "grinding: $after breakages after the restart time"
 else fail "grinding: no breakage after the restart time (the test would not see them)"; fi
+
+# --- The size-aware ore: Vogel-Peukert, t10 progeny and fines, the grate, across the restart ----
+sa=("$src/inputs/grinding_grate.in" --quiet --set run.duration=0.5 --set breakage.start=0.0
+    --set breakage.f_mat=20 --set feed.start=0.0 --set drum.ramp_time=0.1
+    --set output.snapshot_interval=0.1)
+on 1 "${sa[@]}" --output "$tmp/sa_ref"
+on 2 "${sa[@]}" --output "$tmp/sa_part" --set run.duration=0.3
+on 3 "${sa[@]}" --output "$tmp/sa_part" --restart "$tmp/sa_part/checkpoint.h5"
+same_particles "size-aware ore 2 -> 3 particles" "$tmp/sa_ref" "$tmp/sa_part"
+for log in breakages.csv fragments.csv product.csv sizes.csv; do
+  rows=$(($(wc -l <"$tmp/sa_ref/$log") - 1))
+  if cmp -s "$tmp/sa_ref/$log" "$tmp/sa_part/$log"; then pass "size-aware ore 2 -> 3 $log identical ($rows rows)"
+  else fail "size-aware ore 2 -> 3 $log differs"; diff "$tmp/sa_ref/$log" "$tmp/sa_part/$log" | head -4; fi
+done
+if "$py" - "$tmp/sa_ref" <<'EOF'
+import csv, sys
+d = sys.argv[1]
+b = [r for r in csv.DictReader(open(d + "/breakages.csv")) if float(r["time"]) > 0.3]
+p = [r for r in csv.DictReader(open(d + "/product.csv")) if float(r["time"]) > 0.3]
+fines = sum(float(r["fines_mass"]) for r in b)
+sys.exit(0 if b and p and fines > 0 else 1)
+EOF
+then pass "size-aware ore: breaks with fines and grate discharge after the restart time"
+else fail "size-aware ore: no break with fines or no discharge after the restart time"; fi
 
 # --- Refusals: exit 2, on 1 and 2 ranks alike ---------------------------------------------------
 # expect_joined: a message of several lines (the keys that differ) is matched as one.
