@@ -493,7 +493,7 @@ struct TrackPeakEnergy {
   }
 };
 
-// Breakage (docs/models.md, "Grinding: breakage, feed, sieve"): the peak strain energy, the energy
+// Breakage (docs/models.md, "Grinding"): the peak strain energy, the energy
 // at the end of the step (the test runs when it has fallen below the peak: core/mill/grinding.cpp),
 // the peak level already tested, and the birth overlap: bodies that overlapped when one of them was
 // born (a fragment inside its parent's circle) must not repel explosively (thesis), nor pass
