@@ -167,6 +167,13 @@ int run(const Options& opt) {
         " particles, dt = " + fmt_double("%.4g s", sim.dt()) + ", " + std::to_string(g_size) +
         (g_size == 1 ? " rank" : " ranks") + ") -> " + out.directory +
         (resumed ? fmt_double(", continued from t = %.6g s", sim.time()) : "") + "\n");
+  // A [sieve] without `type` may have been written when the aperture was compared with the
+  // radius: the run says how it reads it.
+  if (scene.sieve.present && !scene.where.contains("sieve.type"))
+    say(scene.deck_path + fmt_double(": note: sieve.aperture = %g m is a diameter: ore narrower "
+                                     "than it leaves (a deck that meant a radius gives twice "
+                                     "the value)\n",
+                                     scene.sieve.aperture));
   if (is_ore_scene(scene) && !scene.sieve.present)
     say(scene.deck_path + ": note: no [sieve]: nothing leaves the mill, " + kProductFile +
         " keeps only its header\n");

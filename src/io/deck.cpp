@@ -905,8 +905,8 @@ void record_where(const toml::table& root, const Diagnostics& diag, Scene& scene
   };
   for (const char* key :
        {"run.duration", "run.dt", "drum.speed", "drum.speed_rpm", "drum.critical_fraction",
-        "feed.velocity", "output.directory", "output.series_interval", "output.snapshot_interval",
-        "output.checkpoint_interval"}) {
+        "feed.velocity", "sieve.type", "output.directory", "output.series_interval",
+        "output.snapshot_interval", "output.checkpoint_interval"}) {
     put(key, root.at_path(key).node());
   }
   const auto each = [&](std::string_view name, std::initializer_list<std::string_view> keys) {

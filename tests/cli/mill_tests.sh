@@ -75,6 +75,13 @@ import json
 o = json.load(open('$tmp/nosieve/run.json'))['ore']
 print(o['sieve'], o['discharged_count'])"
 
+# A [sieve] without `type` is told that its aperture is read as a diameter; one with it is not.
+grep -v '^type = "box"' "$gr" > "$tmp/notype.in"
+expect "sieve without type: the aperture read as a diameter, told" 0 'notype\.in: note: sieve\.aperture = 0\.08 m is a diameter: ore narrower than it leaves \(a deck that meant a radius gives twice the value\)' -- \
+  "$dem2d" "$tmp/notype.in" --quiet --set run.duration=0.002 --output "$tmp/notype"
+out=$("$dem2d" "$gr" --quiet --set run.duration=0.002 --output "$tmp/withtype" 2>&1)
+grep -q 'is a diameter' <<<"$out" && fail "sieve with type: told all the same" || pass "sieve with type: no note"
+
 # A short run with spectra on 1 and 3 ranks, and one resumed 1 -> 2 from a checkpoint at 0.3 s.
 run=(--quiet --set run.duration=0.3 --set output.collision_spectra=true --set output.snapshot_interval=0.1
   --set output.analysis_window=0.2)
