@@ -8,6 +8,7 @@
 #include <map>
 #include <numbers>
 
+#include "core/base/errors.hpp"
 #include "core/contact/contact_models.hpp"
 #include "core/run/simulation.hpp"
 #include "core/shape/disc.hpp"
@@ -631,6 +632,56 @@ TEST(Grinding, TheOverflowLetsOutTheFinestUntilTheHoldUpIsBack) {
   EXPECT_LE(sim.diagnostics().ore_mass, s.sieve.holdup);
   sim.step();
   EXPECT_TRUE(sim.grinding()->take_product().empty());
+}
+
+}  // namespace
+}  // namespace dem2d
+
+namespace dem2d {
+namespace {
+
+// Fed ore is placed outside the discharge zone (with its largest radius to spare), where the
+// charge is thinnest: a central box and a grate ring both; a zone that leaves no place is refused.
+TEST(Grinding, TheFeedKeepsOutOfTheDischargeZone) {
+  for (const DischargeType type : {DischargeType::kBox, DischargeType::kGrate}) {
+    Scene s = testing_support::thesis_drum_scene(60, 1.5, 16);
+    s.materials.push_back(thesis_ore());
+    s.feed = {.present = true,
+              .material = "ore",
+              .period = 0.004,
+              .radius_min = 0.05,
+              .radius_max = 0.08};
+    s.sieve = {.present = true,
+               .material = "ore",
+               .type = type,
+               .box_min = {-1.0, -1.0},
+               .box_max = {1.0, 1.0},
+               .aperture = 0.5,  // every fed particle would pass
+               .grate_width = 0.6};
+    Simulation sim(s);
+    std::int64_t seen = 0;
+    const double inner = 2.5 * std::cos(std::numbers::pi / 16) - 0.6;
+    while (sim.time() < 0.2) {
+      sim.step();
+      const ParticleStore& p = sim.particles();
+      if (sim.grinding()->totals().fed_count == seen) continue;
+      seen = sim.grinding()->totals().fed_count;
+      const auto k = static_cast<std::size_t>(
+          std::max_element(p.id.data(), p.id.data() + p.n_owned()) - p.id.data());
+      const Vec2 x = p.pos[k];
+      if (type == DischargeType::kBox)
+        EXPECT_TRUE(std::abs(x.x) > 1.08 || std::abs(x.y) > 1.08) << x.x << ", " << x.y;
+      else
+        EXPECT_LE(norm(x) + 0.08, inner);
+    }
+    EXPECT_GE(seen, 40);
+  }
+  Scene s = testing_support::thesis_drum_scene(60, 1.5, 16);
+  s.materials.push_back(thesis_ore());
+  s.feed = {
+      .present = true, .material = "ore", .period = 0.004, .radius_min = 0.05, .radius_max = 0.08};
+  s.sieve = {.present = true, .material = "ore", .box_min = {-3.0, -3.0}, .box_max = {3.0, 3.0}};
+  EXPECT_THROW(Simulation{s}, InputError);
 }
 
 }  // namespace
