@@ -74,10 +74,10 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
     {"fed_mass", "kg", &SeriesRow::fed_mass, SeriesOnly::kOre,
      "ore scenes: mass fed since the start"},
     {"discharged_count", "", &SeriesRow::discharged_count, SeriesOnly::kOre,
-     "ore scenes: particles the sieve let out since the start (`product.csv`)"},
+     "ore scenes: particles the discharge let out since the start (`product.csv`)"},
     {"discharged_mass", "kg", &SeriesRow::discharged_mass, SeriesOnly::kOre,
-     "ore scenes: their mass; initial `mill_mass` + `fed_mass` = `mill_mass` + "
-     "`discharged_mass` at every row"},
+     "ore scenes: their mass and the fines of t10 breaks (which leave at once); initial "
+     "`mill_mass` + `fed_mass` = `mill_mass` + `discharged_mass` at every row"},
     {"mill_mass", "kg", &SeriesRow::mill_mass, SeriesOnly::kOre,
      "ore scenes: mass of every particle in the mill"},
     {"ore_mass", "kg", &SeriesRow::ore_mass, SeriesOnly::kOre,
@@ -86,8 +86,8 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
      "ore scenes: kinetic and potential energy the fed particles brought in (a term of the "
      "energy balance)"},
     {"discharged_energy", "J", &SeriesRow::discharged_energy, SeriesOnly::kOre,
-     "ore scenes: kinetic, rotational and potential energy the discharged particles took out "
-     "(a term of the energy balance)"},
+     "ore scenes: kinetic, rotational and potential energy the discharged particles and the "
+     "fines took out (a term of the energy balance)"},
     {"shell_torque", "N m", &SeriesRow::shell_torque, SeriesOnly::kDrum,
      "drum scenes: the part of `drum_torque` the shell's contacts take (`drum_torque` − "
      "`lifter_torque`)"},

@@ -97,6 +97,7 @@ bool Grinding::plan(double time, std::int64_t step, const ParticleStore& p,
     if (time >= scene_.breakage.start) run_tests(tests, step, p);
   }
   plan_.remove.assign(p.n_owned(), 0);
+  for (const Broken& b : plan_.broken) plan_.remove[b.index] = 2;  // a broken one cannot leave
   plan_.product.clear();
   plan_.sieved = 0;
   plan_.sieved_mass = 0.0;
@@ -384,7 +385,8 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
   };
   if (s.type != DischargeType::kOverflow) {
     for (std::size_t k = 0; k < p.n_owned(); ++k)
-      if (p.material[k] == sieve_material_ && 2.0 * p.radius[k] < s.aperture && in_zone(p.pos[k]))
+      if (plan_.remove[k] == 0 && p.material[k] == sieve_material_ &&
+          2.0 * p.radius[k] < s.aperture && in_zone(p.pos[k]))
         out(k);
     return;
   }
@@ -393,7 +395,7 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     if (p.material[k] != sieve_material_) continue;
     held += SizeMasses::units(p.mass[k]);
-    if (2.0 * p.radius[k] < s.aperture)
+    if (plan_.remove[k] == 0 && 2.0 * p.radius[k] < s.aperture)
       fine.insert(fine.end(), {std::bit_cast<std::int64_t>(p.radius[k]), p.id[k],
                                SizeMasses::units(p.mass[k])});
   }
