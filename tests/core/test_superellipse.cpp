@@ -1,0 +1,555 @@
+// The superellipse's geometry (core/shape/superellipse.hpp) against independent references:
+//   - support points against a brute-force sweep of the curve (and the defining condition);
+//   - F, its gradient and Hessian against finite differences; the curvature radius against the
+//     ellipse's closed form and the circle's radius;
+//   - area, volume and inertia against 1D tanh-sinh quadratures of the sections (no Gamma
+//     function), and the sphere's 4/3 pi r^3 and 2/5 m r^2 for a = b, n = 2;
+//   - the pair: against the midway point's own definition found by brute force (the level sets
+//     F_i = F_j = c grown until they touch), against the penetration depth (the minimum over
+//     directions of the overlap of the two support functions: the minimum translation distance,
+//     the physical reference), and against dense polygons (8000 vertices each; the exact
+//     penetration depth of two convex polygons over their edge normals); circles exactly;
+//     Newton iterations with and without a warm start;
+//   - walls: a segment's face and ends and the drum's circle against dense polygons; a disc
+//     reproduces Disc::segment and Disc::inside_circle;
+//   - the cost per solve (printed, not asserted).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "core/shape/disc.hpp"
+#include "core/shape/superellipse.hpp"
+
+namespace dem2d {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+Vec2 unit(double phi) { return {std::cos(phi), std::sin(phi)}; }
+
+// The curve's point at polar angle t (body frame).
+Vec2 polar_point(const SuperEllipse& s, double t) {
+  const double c = std::cos(t), sn = std::sin(t);
+  const double r =
+      std::pow(std::pow(std::abs(c) / s.a, s.n) + std::pow(std::abs(sn) / s.b, s.n), -1.0 / s.n);
+  return {r * c, r * sn};
+}
+
+// Golden-section search for the minimum of f on [lo, hi] (unimodal there).
+template <class F>
+double golden_min(F f, double lo, double hi, int steps = 90) {
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+  double f1 = f(x1), f2 = f(x2);
+  for (int k = 0; k < steps; ++k) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = f(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = f(x2);
+    }
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Minimum over the angle of f: a sweep of `count` angles, then golden section about the best.
+template <class F>
+double sweep_min(F f, int count = 1000) {
+  double best = 0.0, fb = f(0.0);
+  const double h = 2.0 * kPi / count;
+  for (int k = 1; k < count; ++k)
+    if (const double v = f(k * h); v < fb) fb = v, best = k * h;
+  return golden_min(f, best - h, best + h);
+}
+
+const double kExponents[] = {2.0, 2.5, 4.0, 8.0, 10.0};
+
+// ---- Support ------------------------------------------------------------------------------------
+
+TEST(SuperEllipse, SupportIsTheFarthestPointOfTheCurve) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  double worst_value = 0.0, worst_point = 0.0, worst_condition = 0.0;
+  for (double n : kExponents)
+    for (double aspect : {1.0, 1.7, 2.5, 4.0})
+      for (int k = 0; k < 40; ++k) {
+        const SuperEllipse s{0.01 * aspect, 0.01, n};
+        const Vec2 u = unit(2.0 * kPi * U(rng));
+        const Vec2 p = support(s, u);
+        // Brute force: the largest u . q over the curve (sweep of the polar angle, refined).
+        const auto minus_reach = [&](double t) { return -dot(u, polar_point(s, t)); };
+        const Vec2 q = polar_point(s, sweep_min(minus_reach, 4000));
+        worst_value = std::max(worst_value, std::abs(dot(u, p) - dot(u, q)) / s.a);
+        worst_point = std::max(worst_point, norm(p - q) / s.a);
+        // The defining conditions: on the curve, its normal along u.
+        const Vec2 g = gradient(s, p);
+        EXPECT_NEAR(implicit(s, p), 0.0, 1e-13);
+        worst_condition = std::max(worst_condition, std::abs(cross(g, u)) / norm(g));
+        EXPECT_GT(dot(g, u), 0.0);
+      }
+  std::printf("support: |u.p - brute| <= %.2e a, |p - brute| <= %.2e a, normal off u %.2e\n",
+              worst_value, worst_point, worst_condition);
+  EXPECT_LT(worst_value, 1e-12);
+  // The point of a maximum is found less sharply than its value (u . q is flat there: a value
+  // to 1e-16 places the point to ~1e-8 sqrt(rho / a), worse on the flat faces of large n).
+  EXPECT_LT(worst_point, 1e-6);
+  EXPECT_LT(worst_condition, 1e-12);
+  // The lab frame: turned and moved.
+  const SuperEllipse s{0.03, 0.01, 4.0};
+  const Vec2 c{0.2, -0.1};
+  const double th = 0.7;
+  const Vec2 u = unit(1.9);
+  const Vec2 p = support_lab(s, c, th, u);
+  const Vec2 pb = support(s, rotate(u, -th));
+  EXPECT_NEAR(norm(p - (c + rotate(pb, th))), 0.0, 1e-15);
+}
+
+// ---- Implicit function and curvature -----------------------------------------------------------
+
+TEST(SuperEllipse, DerivativesMatchFiniteDifferences) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> U(-1.3, 1.3);
+  for (double n : kExponents)
+    for (int k = 0; k < 50; ++k) {
+      const SuperEllipse s{0.02, 0.01, n};
+      const Vec2 p{s.a * U(rng), s.b * U(rng)};
+      const ImplicitValue v = evaluate(s, p);
+      const double h = 1e-6 * s.b;
+      const Vec2 ex{h, 0.0}, ey{0.0, h};
+      const Vec2 gx = (0.5 / h) * Vec2{implicit(s, p + ex) - implicit(s, p - ex),
+                                       implicit(s, p + ey) - implicit(s, p - ey)};
+      const double gscale = norm(v.grad) + 1.0 / s.b;
+      EXPECT_NEAR(v.grad.x, gx.x, 1e-7 * gscale);
+      EXPECT_NEAR(v.grad.y, gx.y, 1e-7 * gscale);
+      const double hxx = (gradient(s, p + ex).x - gradient(s, p - ex).x) / (2.0 * h);
+      const double hyy = (gradient(s, p + ey).y - gradient(s, p - ey).y) / (2.0 * h);
+      const double hxy = (gradient(s, p + ey).x - gradient(s, p - ey).x) / (2.0 * h);
+      const double hscale = std::abs(v.hess.x) + std::abs(v.hess.y) + 1.0 / (s.b * s.b);
+      EXPECT_NEAR(v.hess.x, hxx, 1e-6 * hscale);
+      EXPECT_NEAR(v.hess.y, hyy, 1e-6 * hscale);
+      EXPECT_NEAR(hxy, 0.0, 1e-6 * hscale);
+    }
+  // The axes and the centre: finite for every n (u^(n-2) at u = 0).
+  for (double n : kExponents) {
+    const SuperEllipse s{0.02, 0.01, n};
+    const ImplicitValue v = evaluate(s, {0.0, 0.01});
+    EXPECT_DOUBLE_EQ(v.f, 0.0);
+    EXPECT_EQ(v.hess.x, n == 2.0 ? 2.0 / (s.a * s.a) : 0.0);
+    EXPECT_TRUE(std::isfinite(evaluate(s, {0.0, 0.0}).hess.y));
+  }
+  // Far points: finite (the clamp).
+  EXPECT_TRUE(std::isfinite(implicit(SuperEllipse{1e-3, 1e-3, 50.0}, {1e6, 1e6})));
+}
+
+TEST(SuperEllipse, CurvatureRadiusOfEllipseAndCircle) {
+  const SuperEllipse e{0.03, 0.01, 2.0};
+  for (int k = 0; k < 64; ++k) {
+    const double t = 2.0 * kPi * k / 64;
+    const Vec2 p{e.a * std::cos(t), e.b * std::sin(t)};
+    const double q = e.a * e.a * std::sin(t) * std::sin(t) + e.b * e.b * std::cos(t) * std::cos(t);
+    const double rho = q * std::sqrt(q) / (e.a * e.b);
+    EXPECT_NEAR(curvature_radius(e, p), std::min(rho, kCurvatureRadiusCap * equivalent_radius(e)),
+                1e-12 * rho);
+    EXPECT_NEAR(curvature(e, p), 1.0 / rho, 1e-12 / rho);
+  }
+  const SuperEllipse c{0.01, 0.01, 2.0};
+  for (int k = 0; k < 16; ++k) EXPECT_NEAR(curvature_radius(c, 0.01 * unit(0.4 * k)), 0.01, 1e-15);
+  // The middle of a flat face: the cap.
+  const SuperEllipse box{0.02, 0.01, 8.0};
+  EXPECT_EQ(curvature(box, {0.0, 0.01}), 0.0);
+  EXPECT_DOUBLE_EQ(curvature_radius(box, {0.0, 0.01}),
+                   kCurvatureRadiusCap * equivalent_radius(box));
+}
+
+// ---- Mass and inertia ---------------------------------------------------------------------------
+
+// Tanh-sinh quadrature of f on [0, 1]: exact to rounding for integrands with endpoint
+// singularities like (1 - t^n)^(1/n). f(t, 1 - t).
+template <class F>
+double tanh_sinh(F f) {
+  const double h = 1.0 / 64.0;
+  double sum = 0.0;
+  for (int k = -256; k <= 256; ++k) {
+    const double t = k * h;
+    const double sh = 0.5 * kPi * std::sinh(t);
+    const double w = 0.5 * kPi * std::cosh(t) / (std::cosh(sh) * std::cosh(sh));
+    const double x = 0.5 * (1.0 + std::tanh(sh));
+    const double one_minus_x = 1.0 / (1.0 + std::exp(2.0 * sh));
+    if (x <= 0.0 || one_minus_x <= 0.0) continue;
+    sum += 0.5 * w * f(x);
+  }
+  return sum * h;
+}
+
+TEST(SuperEllipse, MassAndInertiaMatchQuadrature) {
+  for (double n : {2.0, 2.5, 3.0, 4.0, 8.0, 10.0})
+    for (double aspect : {1.0, 2.0, 4.0}) {
+      const SuperEllipse s{0.01 * aspect, 0.01, n};
+      const double c = std::min(s.a, s.b), rho = 7800.0;
+      // The section at height z is the curve scaled by (1 - |z/c|^n)^(1/n).
+      const auto m = [n](double p) {
+        return tanh_sinh([n, p](double t) { return std::pow(1.0 - std::pow(t, n), p / n); });
+      };
+      const double m2 =  // int t^2 (1 - t^n)^(1/n)
+          tanh_sinh([n](double t) { return t * t * std::pow(1.0 - std::pow(t, n), 1.0 / n); });
+      const double a2 = 4.0 * s.a * s.b * m(1.0);
+      const double vol = 2.0 * c * a2 * m(2.0);
+      const double j2 = 4.0 * s.a * s.b * (s.a * s.a * m2 + s.b * s.b * m(3.0) / 3.0);
+      const double iz = rho * 2.0 * c * j2 * m(4.0);
+      EXPECT_NEAR(area(s), a2, 1e-12 * a2) << n;
+      EXPECT_NEAR(volume(s), vol, 1e-12 * vol) << n;
+      EXPECT_NEAR(inertia_z(s, rho), iz, 1e-12 * iz) << n;
+      EXPECT_NEAR(mass(s, rho), rho * vol, 1e-12 * rho * vol);
+      // The bounding radius: the largest |p| over a sweep of the curve, refined.
+      const double t_far = sweep_min([&](double t) { return -norm(polar_point(s, t)); }, 4000);
+      const double brute = norm(polar_point(s, t_far));
+      EXPECT_NEAR(bounding_radius(s), brute, 1e-12 * brute) << n << " " << aspect;
+      EXPECT_GE(bounding_radius(s), std::max(s.a, s.b));
+    }
+  // The sphere: a = b, n = 2.
+  const double r = 0.013, rho = 2700.0;
+  const SuperEllipse s{r, r, 2.0};
+  EXPECT_NEAR(volume(s), 4.0 / 3.0 * kPi * r * r * r, 1e-14 * r * r * r);
+  EXPECT_NEAR(mass(s, rho), Disc::mass(r, rho), 1e-14 * Disc::mass(r, rho));
+  EXPECT_NEAR(inertia_z(s, rho), Disc::inertia(Disc::mass(r, rho), r),
+              1e-14 * Disc::inertia(Disc::mass(r, rho), r));
+  EXPECT_NEAR(equivalent_radius(s), r, 1e-16);
+  EXPECT_NEAR(area(s), kPi * r * r, 1e-15 * r * r);
+}
+
+// ---- Pair references ----------------------------------------------------------------------------
+
+struct Body {
+  SuperEllipse s;
+  SuperPose p;
+};
+
+// The two support points along the lab direction u (from i to j): i's along u, j's along -u,
+// of the bodies grown by ki and kj about their centres.
+struct AxisPoints {
+  Vec2 pi, pj;
+  double overlap;
+};
+AxisPoints along_axis(const Body& i, const Body& j, Vec2 u, double ki = 1.0, double kj = 1.0) {
+  const Vec2 pi = i.p.centre + ki * (support_lab(i.s, {}, i.p.theta, u));
+  const Vec2 pj = j.p.centre + kj * (support_lab(j.s, {}, j.p.theta, -u));
+  return {pi, pj, dot(pi - pj, u)};
+}
+
+// The penetration depth: the least overlap of the support functions over all directions (the
+// minimum translation distance of two convex bodies), its direction and the midpoint of the two
+// support points there.
+struct DepthRef {
+  double depth;
+  Vec2 n, point, pi;
+};
+DepthRef penetration(const Body& i, const Body& j, double ki = 1.0, double kj = 1.0) {
+  const double phi =
+      sweep_min([&](double f) { return along_axis(i, j, unit(f), ki, kj).overlap; }, 720);
+  const AxisPoints a = along_axis(i, j, unit(phi), ki, kj);
+  return {a.overlap, unit(phi), 0.5 * (a.pi + a.pj), a.pi};
+}
+
+// The midway point by its definition: the level sets F_i = F_j = c are the bodies grown by
+// (1 + c)^(1/n) about their centres; c is the level at which they just touch (penetration depth
+// 0, found by regula falsi, Illinois variant), the point is where they touch and the normal the
+// touching direction.
+DepthRef midway_by_definition(const Body& i, const Body& j) {
+  const auto depth_at = [&](double c) {
+    return penetration(i, j, std::pow(1.0 + c, 1.0 / i.s.n), std::pow(1.0 + c, 1.0 / j.s.n));
+  };
+  double lo = -0.5, hi = 0.0, flo = depth_at(lo).depth, fhi = depth_at(hi).depth;
+  int side = 0;
+  for (int k = 0; k < 60 && hi - lo > 1e-15; ++k) {
+    const double c = (lo * fhi - hi * flo) / (fhi - flo);
+    const double fc = depth_at(c).depth;
+    if (std::abs(fc) < 1e-17) return depth_at(c);
+    if (fc < 0.0) {
+      lo = c, flo = fc;
+      if (side == -1) fhi *= 0.5;
+      side = -1;
+    } else {
+      hi = c, fhi = fc;
+      if (side == 1) flo *= 0.5;
+      side = 1;
+    }
+  }
+  return depth_at(0.5 * (lo + hi));
+}
+
+// A random body: aspect 1-4, exponent 2-10 (a third of them ellipses), short axis 6-10 mm.
+Body random_body(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double n = U(rng) < 1.0 / 3.0 ? 2.0 : 2.0 + 8.0 * U(rng);
+  const double b = 0.006 + 0.004 * U(rng);
+  return {{b * (1.0 + 3.0 * U(rng)), b, n}, {{0.0, 0.0}, 2.0 * kPi * U(rng)}};
+}
+
+// Two random bodies overlapping by a depth of 0.1-5 % (log-uniform) of the smaller bounding
+// radius: j placed along a random direction, its distance corrected by Newton on the depth.
+struct PairCase {
+  Body i, j;
+  double size;
+  DepthRef mtd;
+};
+PairCase random_pair(std::mt19937_64& rng);
+PairCase random_pair_try(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  PairCase c{random_body(rng), random_body(rng), 0.0, {}};
+  c.i.p.centre = {0.1 * U(rng), 0.1 * U(rng)};
+  c.size = std::min(bounding_radius(c.i.s), bounding_radius(c.j.s));
+  const double target = c.size * std::exp(std::log(0.001) + U(rng) * std::log(50.0));
+  const Vec2 u = unit(2.0 * kPi * U(rng));
+  double D = along_axis({c.i.s, {{}, c.i.p.theta}}, {c.j.s, {{}, c.j.p.theta}}, u).overlap - target;
+  for (int k = 0; k < 8; ++k) {
+    c.j.p.centre = c.i.p.centre + D * u;
+    c.mtd = penetration(c.i, c.j);
+    if (std::abs(c.mtd.depth - target) < 1e-4 * target) break;
+    D += (c.mtd.depth - target) / std::max(dot(u, c.mtd.n), 0.2);
+  }
+  return c;
+}
+// Tries until the depth is within 0.1-5 % (the correction can fail for elongated bodies side by
+// side; those poses are drawn again).
+PairCase random_pair(std::mt19937_64& rng) {
+  for (;;) {
+    const PairCase c = random_pair_try(rng);
+    if (c.mtd.depth >= 0.001 * c.size && c.mtd.depth <= 0.05 * c.size) return c;
+  }
+}
+
+double angle_between(Vec2 a, Vec2 b) { return std::abs(std::atan2(cross(a, b), dot(a, b))); }
+
+// A dense polygon on the curve, counter-clockwise, in the lab frame: half its vertices evenly in
+// the polar angle (dense along flat faces), half evenly in the normal's angle (dense at corners).
+std::vector<Vec2> polygon(const Body& b, int count) {
+  std::vector<std::pair<double, Vec2>> v;
+  for (int k = 0; k < count / 2; ++k) {
+    const double t = 2.0 * kPi * (k + 0.5) / (count / 2);
+    const Vec2 q = polar_point(b.s, t);
+    v.push_back({std::atan2(q.y, q.x), q});
+    const Vec2 r = support(b.s, unit(t));
+    v.push_back({std::atan2(r.y, r.x), r});
+  }
+  std::sort(v.begin(), v.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<Vec2> out;
+  for (const auto& [ang, q] : v) out.push_back(b.p.centre + rotate(q, b.p.theta));
+  return out;
+}
+
+// Index of the vertex of a convex polygon farthest along u, by climbing from `k`.
+std::size_t climb(const std::vector<Vec2>& P, Vec2 u, std::size_t k) {
+  const std::size_t N = P.size();
+  for (bool moved = true; moved;) {
+    moved = false;
+    while (dot(P[(k + 1) % N], u) > dot(P[k], u)) k = (k + 1) % N, moved = true;
+    while (dot(P[(k + N - 1) % N], u) > dot(P[k], u)) k = (k + N - 1) % N, moved = true;
+  }
+  return k;
+}
+
+// Exact penetration depth of two convex polygons: the least overlap over the edge normals of P
+// (outward) and the reversed edge normals of Q (the Minkowski difference's edge normals).
+DepthRef polygon_depth(const std::vector<Vec2>& P, const std::vector<Vec2>& Q) {
+  DepthRef best{1e300, {}, {}, {}};
+  std::size_t kp = 0, kq = 0;
+  const auto consider = [&](Vec2 u) {
+    kp = climb(P, u, kp);
+    kq = climb(Q, -u, kq);
+    const double ov = dot(P[kp] - Q[kq], u);
+    if (ov < best.depth) best = {ov, u, 0.5 * (P[kp] + Q[kq]), P[kp]};
+  };
+  for (const auto* R : {&P, &Q})
+    for (std::size_t k = 0; k < R->size(); ++k) {
+      const Vec2 e = (*R)[(k + 1) % R->size()] - (*R)[k];
+      const Vec2 m = (1.0 / norm(e)) * Vec2{e.y, -e.x};
+      consider(R == &P ? m : -m);
+    }
+  return best;
+}
+
+// ---- Pair tests ---------------------------------------------------------------------------------
+
+struct Stats {
+  std::vector<double> v;
+  void add(double x) { v.push_back(x); }
+  double max() const { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); }
+  double quantile(double q) const {
+    std::vector<double> s = v;
+    std::sort(s.begin(), s.end());
+    return s.empty() ? 0.0 : s[static_cast<std::size_t>(q * (s.size() - 1))];
+  }
+  void print(const char* what) const {
+    std::printf("  %-44s median %.2e  95%% %.2e  max %.2e\n", what, quantile(0.5), quantile(0.95),
+                max());
+  }
+};
+
+void print_histogram(const char* what, const std::map<int, int>& h) {
+  std::printf("  %s:", what);
+  for (const auto& [it, count] : h) std::printf("  %d it: %d", it, count);
+  std::printf("\n");
+}
+
+constexpr int kPairCases = 400;
+
+TEST(SuperEllipse, PairMatchesTheMidwayDefinitionAndThePenetrationDepth) {
+  std::mt19937_64 rng(2024);
+  Stats own_angle, own_point, mtd_angle, mtd_depth, mtd_point, poly_depth, poly_angle;
+  std::map<int, int> cold, warm;
+  int failures = 0, fallbacks = 0;
+  for (int k = 0; k < kPairCases; ++k) {
+    const PairCase c = random_pair(rng);
+    const SuperPairContact r = contact_pair(c.i.s, c.i.p, c.j.s, c.j.p);
+    ++cold[r.iterations];
+    if (!r.converged) {
+      std::printf(
+          "  not converged: candidate %d, %d it, depth %.3g of the size, n %.2f %.2f, "
+          "aspects %.2f %.2f\n",
+          r.candidate, r.iterations, c.mtd.depth / c.size, c.i.s.n, c.j.s.n, c.i.s.a / c.i.s.b,
+          c.j.s.a / c.j.s.b);
+      ++fallbacks;
+      continue;
+    }
+    const DepthRef own = midway_by_definition(c.i, c.j);
+    own_angle.add(angle_between(r.n, own.n));
+    own_point.add(norm(r.midway - own.pi) / c.size);
+    mtd_angle.add(angle_between(r.n, c.mtd.n));
+    mtd_depth.add(std::abs(r.delta - c.mtd.depth) / c.mtd.depth);
+    mtd_point.add(norm(r.point - c.mtd.point) / c.size);
+    if (r.delta <= 0.0) ++failures;
+    if (k % 4 == 0) {  // the polygons: 8000 vertices each
+      const DepthRef p = polygon_depth(polygon(c.i, 8000), polygon(c.j, 8000));
+      poly_depth.add(std::abs(p.depth - c.mtd.depth) / c.mtd.depth);
+      poly_angle.add(angle_between(p.n, c.mtd.n));
+    }
+    // A warm start from this point after a step's motion: 1e-4 of the size and 1e-4 rad.
+    PairCase m = c;
+    m.j.p.centre += (1e-4 * c.size) * unit(2.0 * kPi * std::uniform_real_distribution<>(0, 1)(rng));
+    m.i.p.theta += 1e-4;
+    m.j.p.theta -= 1e-4;
+    const SuperPairContact w = contact_pair(m.i.s, m.i.p, m.j.s, m.j.p, &r.midway);
+    ++warm[w.iterations];
+    EXPECT_TRUE(w.converged);
+    EXPECT_LE(w.iterations, 3);
+  }
+  std::printf("pair, %d random poses (aspect 1-4, n 2-10, depth 0.1-5 %% of the size):\n",
+              kPairCases);
+  own_angle.print("normal vs the midway definition (rad)");
+  own_point.print("midway point vs its definition (/ size)");
+  mtd_angle.print("normal vs the penetration depth's (rad)");
+  mtd_depth.print("overlap vs the penetration depth (relative)");
+  mtd_point.print("contact point vs the depth's midpoint (/size)");
+  poly_depth.print("polygon depth vs support depth (relative)");
+  poly_angle.print("polygon normal vs support normal (rad)");
+  print_histogram("iterations, cold", cold);
+  print_histogram("iterations, warm", warm);
+  std::printf("  not converged (fallback): %d, overlap <= 0 when converged: %d\n", fallbacks,
+              failures);
+  // Measured (seed 2024): 3 of 400 cold solves do not converge in 30 steps (elongated bodies
+  // of large n, the merit's false minima); the warm solves all converge in 2-3 steps.
+  EXPECT_LE(fallbacks, kPairCases / 100);
+  EXPECT_EQ(failures, 0);
+  // The solver finds the midway point of its definition; the point itself is ill-conditioned
+  // where two flat faces meet (the level sets touch along a near-segment), the normal is not.
+  EXPECT_LT(own_angle.max(), 1e-6);
+  EXPECT_LT(own_point.quantile(0.9), 1e-6);
+  // Against the penetration depth the midway point's normal and overlap differ at first order
+  // in the overlap (the level sets F = c are not parallel to the curve): printed, not asserted.
+}
+
+TEST(SuperEllipse, CirclesGiveTheDiscsOverlapOnTheLineOfCentres) {
+  const SuperEllipse a{0.01, 0.01, 2.0}, b{0.007, 0.007, 2.0};
+  const SuperPose pa{{0.1, 0.2}, 0.3}, pb{{0.1 + 0.0165, 0.2 + 0.002}, -1.1};
+  const SuperPairContact r = contact_pair(a, pa, b, pb);
+  const Vec2 d = pb.centre - pa.centre;
+  ASSERT_TRUE(r.converged);
+  EXPECT_NEAR(r.delta, 0.017 - norm(d), 1e-15);
+  EXPECT_LT(angle_between(r.n, d), 1e-14);
+  EXPECT_NEAR(r.rho_i, 0.01, 1e-15);
+  EXPECT_NEAR(r.rho_j, 0.007, 1e-15);
+}
+
+TEST(SuperEllipse, DiscAgainstWallsMatchesTheDiscShape) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double r = 0.01;
+  const SuperEllipse s{r, r, 2.0};
+  const Vec2 a{-0.05, 0.0}, b{0.05, 0.01};
+  int ends = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Vec2 x{-0.07 + 0.14 * U(rng), -0.012 + 0.024 * U(rng)};
+    const WallGeometry g = Disc::segment(a, b, x, r);
+    const SuperWallContact c = contact_segment(s, x, 6.0 * U(rng), a, b);
+    ends += c.iterations > 0;
+    EXPECT_NEAR(c.contact.g.delta, g.delta, 1e-13);
+    EXPECT_LT(angle_between(c.contact.g.n, g.n), 1e-11);
+    EXPECT_LT(norm(c.contact.g.point - g.point), 1e-13);
+    EXPECT_LT(norm(c.contact.arm - r * g.n), 1e-12);
+  }
+  EXPECT_GT(ends, 20);  // the ends were reached
+  const Vec2 C{0.3, -0.2};
+  const double R = 0.5;
+  for (int k = 0; k < 100; ++k) {
+    const Vec2 x = C + (R - r + 0.001 * (U(rng) - 0.5)) * unit(6.3 * U(rng));
+    const WallGeometry g = Disc::inside_circle(C, R, x - C, norm(x - C), r);
+    const SuperWallContact c = contact_inside_circle(s, x, 6.0 * U(rng), C, R);
+    EXPECT_TRUE(c.converged);
+    EXPECT_NEAR(c.contact.g.delta, g.delta, 1e-15);
+    EXPECT_LT(angle_between(c.contact.g.n, g.n), 1e-12);
+    EXPECT_LT(norm(c.contact.g.point - g.point), 1e-14);
+  }
+}
+
+// The cost per call (printed): cold and warm pair solves, segment and circle contacts.
+TEST(SuperEllipse, CostPerSolve) {
+  std::mt19937_64 rng(99);
+  std::vector<PairCase> cases;
+  for (int k = 0; k < 100; ++k) cases.push_back(random_pair(rng));
+  std::vector<Vec2> points(cases.size());
+  using Clock = std::chrono::steady_clock;
+  const auto ns_per = [](Clock::time_point t0, int count) {
+    return std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / count;
+  };
+  double sink = 0.0;
+  constexpr int kReps = 20;
+  auto t0 = Clock::now();
+  for (int rep = 0; rep < kReps; ++rep)
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      const PairCase& c = cases[k];
+      const SuperPairContact r = contact_pair(c.i.s, c.i.p, c.j.s, c.j.p);
+      points[k] = r.midway;
+      sink += r.delta;
+    }
+  const double cold = ns_per(t0, kReps * static_cast<int>(cases.size()));
+  t0 = Clock::now();
+  for (int rep = 0; rep < kReps; ++rep)
+    for (std::size_t k = 0; k < cases.size(); ++k) {
+      const PairCase& c = cases[k];
+      sink += contact_pair(c.i.s, c.i.p, c.j.s, c.j.p, &points[k]).delta;
+    }
+  const double warm = ns_per(t0, kReps * static_cast<int>(cases.size()));
+  t0 = Clock::now();
+  for (int rep = 0; rep < kReps; ++rep)
+    for (const PairCase& c : cases)
+      sink += contact_segment(c.i.s, c.i.p.centre, c.i.p.theta, {-1.0, -0.005}, {1.0, -0.005})
+                  .contact.g.delta;
+  const double seg = ns_per(t0, kReps * static_cast<int>(cases.size()));
+  t0 = Clock::now();
+  for (int rep = 0; rep < kReps; ++rep)
+    for (const PairCase& c : cases)
+      sink +=
+          contact_inside_circle(c.i.s, c.i.p.centre, c.i.p.theta, {0.05, 0.5}, 0.5).contact.g.delta;
+  const double circ = ns_per(t0, kReps * static_cast<int>(cases.size()));
+  std::printf("cost: pair cold %.0f ns, warm %.0f ns; segment %.0f ns; circle %.0f ns (%g)\n", cold,
+              warm, seg, circ, sink);
+}
+
+}  // namespace
+}  // namespace dem2d
