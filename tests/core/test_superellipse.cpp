@@ -508,48 +508,5 @@ TEST(SuperEllipse, DiscAgainstWallsMatchesTheDiscShape) {
 }
 
 // The cost per call (printed): cold and warm pair solves, segment and circle contacts.
-TEST(SuperEllipse, CostPerSolve) {
-  std::mt19937_64 rng(99);
-  std::vector<PairCase> cases;
-  for (int k = 0; k < 100; ++k) cases.push_back(random_pair(rng));
-  std::vector<Vec2> points(cases.size());
-  using Clock = std::chrono::steady_clock;
-  const auto ns_per = [](Clock::time_point t0, int count) {
-    return std::chrono::duration<double, std::nano>(Clock::now() - t0).count() / count;
-  };
-  double sink = 0.0;
-  constexpr int kReps = 20;
-  auto t0 = Clock::now();
-  for (int rep = 0; rep < kReps; ++rep)
-    for (std::size_t k = 0; k < cases.size(); ++k) {
-      const PairCase& c = cases[k];
-      const SuperPairContact r = contact_pair(c.i.s, c.i.p, c.j.s, c.j.p);
-      points[k] = r.midway;
-      sink += r.delta;
-    }
-  const double cold = ns_per(t0, kReps * static_cast<int>(cases.size()));
-  t0 = Clock::now();
-  for (int rep = 0; rep < kReps; ++rep)
-    for (std::size_t k = 0; k < cases.size(); ++k) {
-      const PairCase& c = cases[k];
-      sink += contact_pair(c.i.s, c.i.p, c.j.s, c.j.p, &points[k]).delta;
-    }
-  const double warm = ns_per(t0, kReps * static_cast<int>(cases.size()));
-  t0 = Clock::now();
-  for (int rep = 0; rep < kReps; ++rep)
-    for (const PairCase& c : cases)
-      sink += contact_segment(c.i.s, c.i.p.centre, c.i.p.theta, {-1.0, -0.005}, {1.0, -0.005})
-                  .contact.g.delta;
-  const double seg = ns_per(t0, kReps * static_cast<int>(cases.size()));
-  t0 = Clock::now();
-  for (int rep = 0; rep < kReps; ++rep)
-    for (const PairCase& c : cases)
-      sink +=
-          contact_inside_circle(c.i.s, c.i.p.centre, c.i.p.theta, {0.05, 0.5}, 0.5).contact.g.delta;
-  const double circ = ns_per(t0, kReps * static_cast<int>(cases.size()));
-  std::printf("cost: pair cold %.0f ns, warm %.0f ns; segment %.0f ns; circle %.0f ns (%g)\n", cold,
-              warm, seg, circ, sink);
-}
-
 }  // namespace
 }  // namespace dem2d
