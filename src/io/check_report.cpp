@@ -1,5 +1,7 @@
 #include "io/check_report.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -80,6 +82,42 @@ std::string wall_time_line(const Trial& trial, double particle_steps, bool birth
 
 // When ore starts to break, and whether the fill is still falling then: the free fall of its
 // highest particle to the lowest point of the shell.
+std::string breakage_line(const Scene& s, const ParticleStore& p);
+
+// The ore's laws and where it leaves, in words (docs/models.md, "Grinding").
+std::string ore_lines(const Scene& s) {
+  std::string out;
+  if (s.breakage.present) {
+    const BreakageSpec& b = s.breakage;
+    out += b.model == BreakageModel::kVogelPeukert
+               ? fmt::format(
+                     "  breakage law:          Vogel-Peukert, f_mat {:g} kg/(J m), x W_min "
+                     "{:g} J m/kg",
+                     b.f_mat, b.xw_min)
+               : fmt::format("  breakage law:          thesis, E_min {:g} J, S {:g} 1/J",
+                             b.minimum_energy, b.strength);
+    out += b.energy_split == EnergySplit::kCompliance ? ", each body its compliance share"
+                                                      : ", each body the whole energy";
+    out += b.fragments == FragmentLaw::kT10
+               ? fmt::format("; t10 progeny (A {:g} %, b {:g} t/kWh), fines below {:g} m\n",
+                             b.t10_a, b.t10_b, b.fines_diameter)
+               : fmt::format("; {}-{} equal fragments\n", b.fragments_min, b.fragments_max);
+  }
+  if (s.sieve.present) {
+    const SieveSpec& v = s.sieve;
+    out +=
+        fmt::format("  discharge:             ore narrower than {:g} m (a diameter) ", v.aperture);
+    if (v.type == DischargeType::kGrate)
+      out += fmt::format("in the grate ring, the last {:g} m inside the shell\n", v.grate_width);
+    else if (v.type == DischargeType::kOverflow)
+      out += fmt::format("above an ore hold-up of {:g} kg, the finest first\n", v.holdup);
+    else
+      out += fmt::format("in the box [{:g}, {:g}] to [{:g}, {:g}]\n", v.box_min.x, v.box_min.y,
+                         v.box_max.x, v.box_max.y);
+  }
+  return out;
+}
+
 std::string breakage_line(const Scene& s, const ParticleStore& p) {
   std::string out =
       fmt_double("  breakage from:         t = %.4g s (breakage.start)", s.breakage.start);
@@ -129,6 +167,7 @@ std::string check_report(const Simulation& sim, const Trial& trial) {
   out += "  particles:             " + std::to_string(p.n_owned()) + "\n";
   if (s.drum.present) out += mill_check_lines(s, mill_numbers(s, charge_sizes(p, Domain{})));
   if (s.breakage.present) out += breakage_line(s, p);
+  out += ore_lines(s);
   out += fmt_double("  Rayleigh time:         %.4e s (smallest particle)\n", ts.rayleigh);
   out += fmt_double("  Hertz contact time:    %.4e s", ts.hertz) +
          fmt_double(" at %.3f m/s (largest expected impact speed)\n", ts.impact_speed);

@@ -64,6 +64,10 @@ expect "check wall time estimate" 0 'wall time estimate: +[0-9.e+]+ s on 1 rank 
 expect "check breakage while the fill falls" 0 'breakage from: +t = 0 s \(breakage\.start\); the fill falls until about 0\.66 s' -- \
   "$dem2d" --check --set breakage.start=0 "$gr"
 expect "check breakage after the fill" 0 'breakage from: +t = 1 s \(breakage\.start\)$' -- "$dem2d" --check "$gr"
+expect "check the ore's laws" 0 'breakage law: +Vogel-Peukert, f_mat 1 kg/\(J m\), x W_min 0\.05 J m/kg, each body its compliance share; t10 progeny \(A 60 %, b 1 t/kWh\), fines below 0\.02 m$' -- \
+  "$dem2d" --check "$src/inputs/grinding_grate.in"
+expect "check the discharge" 0 'discharge: +ore narrower than 0\.06 m \(a diameter\) in the grate ring, the last 0\.15 m inside the shell$' -- \
+  "$dem2d" --check "$src/inputs/grinding_grate.in"
 
 # An ore deck without a [sieve] says at its start that nothing leaves the mill, and run.json's
 # ore object says so.
