@@ -273,10 +273,11 @@ SuperWallContact contact_inside_circle(const SuperEllipse& s, Vec2 centre, doubl
   bool converged = false;
   while (k < opt.max_iter && !converged) {
     const Vec2 u{std::cos(phi), std::sin(phi)};
-    pb = support(s, to_body(u, cs));
+    const SupportCurvature sc = support_curvature(s, to_body(u, cs));
+    pb = sc.p;
     w = d + to_lab(pb, cs);  // p - c
     const double step = std::atan2(cross(u, w), dot(u, w));
-    const double ks = curvature(s, pb) * norm(w);  // |p - c| / rho
+    const double ks = sc.kappa * norm(w);  // |p - c| / rho
     phi += ks > 2.0 ? step * ks / (ks - 1.0) : step;
     ++k;
     converged = std::abs(step) <= opt.tol;
