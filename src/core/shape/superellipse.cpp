@@ -411,10 +411,11 @@ DepthEval depth_at(const Body& bi, const Body& bj, double phi) {
 // Newton's next angle for g' = 0 from e. Near a body's axis direction phi_a (of the body with the
 // larger curvature radius there, exponent n > 2), its support point moves as sign(d) |d|^(1/(n-1))
 // with d = phi - phi_a (a flat face's middle sweeps by in a tiny angle), so g' is taken as a
-// function of s = sign(d) |d|^(1/(n-1)), nearly linear in it, instead of phi. Not finite (exactly
-// on an axis): a step of `reach` downhill.
+// function of s = sign(d) |d|^(1/(n-1)), nearly linear in it, instead of phi. g'' <= 0: a step of
+// `reach` downhill; infinite (exactly on an axis, where s is flat): a tiny step off it, downhill.
 double newton_angle(const Body& bi, const Body& bj, const DepthEval& e, double reach) {
-  if (!(e.ddg > 0.0) || !std::isfinite(e.ddg)) return e.phi - std::copysign(reach, e.dg);
+  if (!(e.ddg > 0.0)) return e.phi - std::copysign(reach, e.dg);
+  if (!std::isfinite(e.ddg)) return e.phi - std::copysign(1e-3 * kFlatReach * reach, e.dg);
   const Body& b = e.kappa_i <= e.kappa_j ? bi : bj;
   const double p = b.s->n - 1.0;
   const double quarter = 0.5 * std::numbers::pi;
