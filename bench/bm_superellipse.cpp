@@ -1,7 +1,8 @@
 // The superellipse's contact solves (src/core/shape/superellipse.hpp), ns each: a pair by the
-// midway-point method from a cold start and warm-started from its own converged point, and a body
-// against a segment and inside a circle. The poses: 64 pairs of random superellipses (aspect 1-4,
-// exponent 2-10, random angles) overlapping by about 1 % of their size along a random direction.
+// penetration depth (and the midway point) from a cold start and warm-started from its own midway
+// point, and a body against a segment (its face, and past its end) and inside a circle. The poses:
+// 64 pairs of random superellipses (aspect 1-4, exponent 2-10, random angles) overlapping by about
+// 1 % of their size along a random direction.
 //
 //   build/bench/bm_superellipse [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
@@ -81,6 +82,19 @@ void Segment(benchmark::State& state) {
   }
 }
 BENCHMARK(Segment);
+
+// The segment ending under the bodies: the deepest point often projects past its end (about half
+// of the poses), where the end's 1D minimisation runs.
+void SegmentEnd(benchmark::State& state) {
+  const std::vector<Pose> p = poses();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Pose& x = p[k++ % p.size()];
+    benchmark::DoNotOptimize(
+        contact_segment(x.si, {0.0, 0.0}, x.pi.theta, {-1.0, -0.04}, {0.0, -0.04}).contact.g.delta);
+  }
+}
+BENCHMARK(SegmentEnd);
 
 void InsideCircle(benchmark::State& state) {
   const std::vector<Pose> p = poses();

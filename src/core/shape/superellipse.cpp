@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 namespace dem2d {
@@ -28,8 +29,25 @@ AxisTerm axis_term(double x, double a, double n) {
   return {u1 * u, std::copysign(n / a * u1, x), n * (n - 1.0) / (a * a) * w};
 }
 
-// The cap of the curvature radius of one body.
-double radius_cap(const SuperEllipse& s) { return kCurvatureRadiusCap * equivalent_radius(s); }
+// The cap of the curvature radius of one body: curvature_radius_cap, remembered for the last two
+// shapes asked for on this thread (a pair's two bodies, or a mill of one or two shapes, hit it);
+// a miss costs three Gamma functions and a cube root.
+double radius_cap(const SuperEllipse& s) {
+  struct Entry {
+    double a = -1.0, b = -1.0, n = -1.0, cap = 0.0;
+  };
+  thread_local Entry memo[2];
+  thread_local int older = 0;
+  for (const Entry& e : memo)
+    if (e.a == s.a && e.b == s.b && e.n == s.n) return e.cap;
+  Entry& e = memo[older];
+  older = 1 - older;
+  e = {s.a, s.b, s.n, kCurvatureRadiusCap * equivalent_radius(s)};
+  return e.cap;
+}
+
+// 1 / kappa capped at `cap` (kappa >= 0).
+double capped_inverse(double kappa, double cap) { return kappa * cap > 1.0 ? 1.0 / kappa : cap; }
 
 // 1 / kappa at a body-frame point of the curve, at most `cap`.
 double capped_radius(const SuperEllipse& s, Vec2 p, double cap) {
@@ -96,6 +114,38 @@ double curvature(const SuperEllipse& s, Vec2 p) {
 
 double curvature_radius(const SuperEllipse& s, Vec2 p) {
   return capped_radius(s, p, radius_cap(s));
+}
+
+double curvature_radius(const SuperEllipse& s, Vec2 p, double cap) {
+  return capped_radius(s, p, cap);
+}
+
+double curvature_radius_cap(const SuperEllipse& s) { return radius_cap(s); }
+
+// support() with the curvature there, without another pow: with rx = a|u_x| / m, sx = rx^q and
+// N^n = sx rx + sy ry, the scaled coordinate X = |x|/a = sx / N has X^(n-1) = rx / N^(n-1) and
+// X^(n-2) = (rx / sx) N^2 / N^n (rx / sx = rx^((n-2)/(n-1)): 1 at rx = 0 for n = 2, else 0).
+// The common factor n / N^(n-1) of the gradient cancels but once in kappa.
+SupportCurvature support_curvature(const SuperEllipse& s, Vec2 u) {
+  const double ax = s.a * std::abs(u.x);
+  const double by = s.b * std::abs(u.y);
+  const double m = std::max(ax, by);
+  if (!(m > 0.0)) return {{s.a, 0.0}, curvature(s, {s.a, 0.0})};
+  const double q = 1.0 / (s.n - 1.0);
+  const double rx = ax / m, ry = by / m;
+  const double sx = std::pow(rx, q), sy = std::pow(ry, q);
+  const double Nn = sx * rx + sy * ry;
+  const double N = std::pow(Nn, 1.0 / s.n);
+  const Vec2 p{std::copysign(s.a * sx / N, u.x), std::copysign(s.b * sy / N, u.y)};
+  const double flat = s.n > 2.0 ? 0.0 : 1.0;
+  const double wx = (sx > 0.0 ? rx / sx : flat) * N * N / Nn;  // X^(n-2)
+  const double wy = (sy > 0.0 ? ry / sy : flat) * N * N / Nn;  // Y^(n-2)
+  // grad F = c (rx / a, ry / b), c = n / N^(n-1) = n N / N^n; F_xx = n (n-1) / a^2 X^(n-2).
+  const double c = s.n * N / Nn;
+  const double gx = rx / s.a, gy = ry / s.b;
+  const double g = std::hypot(gx, gy);
+  const double num = s.n * (s.n - 1.0) * (gy * gy * wx / (s.a * s.a) + gx * gx * wy / (s.b * s.b));
+  return {p, num / (c * g * g * g)};
 }
 
 // ---- Size, mass, inertia ------------------------------------------------------------------------
@@ -206,25 +256,6 @@ SuperWallContact contact_point(const SuperEllipse& s, Vec2 centre, double theta,
   return r;
 }
 
-SuperWallContact contact_segment(const SuperEllipse& s, Vec2 centre, double theta, Vec2 a, Vec2 b,
-                                 const SolveOptions& opt) {
-  const Vec2 ab = b - a;
-  const double len2 = norm2(ab);
-  if (!(len2 > 0.0)) return contact_point(s, centre, theta, a, opt);
-  const double len = std::sqrt(len2);
-  const Vec2 t = (1.0 / len) * ab;
-  Vec2 m = perp(t);  // the line's unit normal on the body's side
-  if (dot(m, centre - a) < 0.0) m = -m;
-  // The deepest point beyond the line: the support point along -m (towards the wall).
-  const Vec2 cs = angle_cs(theta);
-  const Vec2 pb = support(s, to_body(-m, cs));
-  const Vec2 p = centre + to_lab(pb, cs);
-  const double along = dot(p - a, t);
-  if (along < 0.0 || along > len) return contact_point(s, centre, theta, along < 0.0 ? a : b, opt);
-  const double h = dot(p - a, m);  // < 0 beyond the line
-  return make_wall_contact(s, centre, p, pb, -m, -h, p - h * m);
-}
-
 // The body's point p farthest from c: there the body's normal u points along p - c. Parametrise
 // the curve by the angle phi of its normal u (p = support point along u) and turn u onto p - c:
 // that angle map has slope rho / |p - c| (rho the curvature radius at p), below 1 at a maximum
@@ -242,10 +273,11 @@ SuperWallContact contact_inside_circle(const SuperEllipse& s, Vec2 centre, doubl
   bool converged = false;
   while (k < opt.max_iter && !converged) {
     const Vec2 u{std::cos(phi), std::sin(phi)};
-    pb = support(s, to_body(u, cs));
+    const SupportCurvature sc = support_curvature(s, to_body(u, cs));
+    pb = sc.p;
     w = d + to_lab(pb, cs);  // p - c
     const double step = std::atan2(cross(u, w), dot(u, w));
-    const double ks = curvature(s, pb) * norm(w);  // |p - c| / rho
+    const double ks = sc.kappa * norm(w);  // |p - c| / rho
     phi += ks > 2.0 ? step * ks / (ks - 1.0) : step;
     ++k;
     converged = std::abs(step) <= opt.tol;
@@ -345,57 +377,146 @@ bool damped_step(const Body& bi, const Body& bj, double L, double reach, Midway&
   return false;
 }
 
-// The root t of (F + 1)^(1/n) = 1 along x + t n nearest to t = 0 (Newton on the body's norm,
-// nearly linear along a line; at most 12 steps, to 1e-15 of the bounding radius).
-double surface_along(const Body& b, Vec2 x, Vec2 n) {
-  const Vec2 xb = to_body(x - b.c, b.cs);
-  const Vec2 nb = to_body(n, b.cs);
-  const double stop = 1.0e-15 * bounding_radius(*b.s);
-  double t = 0.0;
-  for (int k = 0; k < 12; ++k) {
-    const NormValue v = body_norm(*b.s, xb + t * nb);
-    const double slope = dot(v.grad, nb);
-    if (!(std::abs(slope) > 0.0)) break;
-    const double dt = (1.0 - v.value) / slope;
-    t += dt;
-    if (std::abs(dt) <= stop) break;
+// The overlap of the two bodies' support points along the lab direction u(phi) (i's along u, j's
+// along -u): g = u . (p_i - p_j) = h_i(u) + h_j(-u) - u . (x_j - x_i), its derivative
+// g' = u_perp . (p_i - p_j) (the support points move along the curves, normal to u) and
+// g'' = rho_i + rho_j - g (they move at the curvature radius per radian). Its minimum over phi
+// is the penetration depth.
+// Within this angle (rad) of a body's axis direction its flat face's Newton variable is used.
+constexpr double kFlatReach = 0.1;
+
+struct DepthEval {
+  double phi;
+  Vec2 u, pi, pj;
+  double kappa_i, kappa_j;
+  double g, dg, ddg;
+};
+DepthEval depth_at(const Body& bi, const Body& bj, double phi) {
+  DepthEval e{phi, {std::cos(phi), std::sin(phi)}, {}, {}, 0.0, 0.0, 0.0, 0.0, 0.0};
+  const SupportCurvature si = support_curvature(*bi.s, to_body(e.u, bi.cs));
+  // A body without a shape is a point (a segment's end): its own support, no radius.
+  const SupportCurvature sj = bj.s ? support_curvature(*bj.s, to_body(-e.u, bj.cs))
+                                   : SupportCurvature{{}, std::numeric_limits<double>::infinity()};
+  e.pi = bi.c + to_lab(si.p, bi.cs);
+  e.pj = bj.c + to_lab(sj.p, bj.cs);
+  e.kappa_i = si.kappa;
+  e.kappa_j = sj.kappa;
+  const Vec2 w = e.pi - e.pj;
+  e.g = dot(e.u, w);
+  e.dg = dot(perp(e.u), w);
+  e.ddg = 1.0 / si.kappa + 1.0 / sj.kappa - e.g;  // +inf on a flat face's middle
+  return e;
+}
+
+// Newton's next angle for g' = 0 from e. Near a body's axis direction phi_a (of the body with the
+// larger curvature radius there, exponent n > 2), its support point moves as sign(d) |d|^(1/(n-1))
+// with d = phi - phi_a (a flat face's middle sweeps by in a tiny angle), so g' is taken as a
+// function of s = sign(d) |d|^(1/(n-1)), nearly linear in it, instead of phi. g'' <= 0: a step of
+// `reach` downhill; infinite (exactly on an axis, where s is flat): a tiny step off it, downhill.
+double newton_angle(const Body& bi, const Body& bj, const DepthEval& e, double reach) {
+  if (!(e.ddg > 0.0)) return e.phi - std::copysign(reach, e.dg);
+  if (!std::isfinite(e.ddg)) return e.phi - std::copysign(1e-3 * kFlatReach * reach, e.dg);
+  const Body& b = e.kappa_i <= e.kappa_j ? bi : bj;
+  const double p = b.s->n - 1.0;
+  const double quarter = 0.5 * std::numbers::pi;
+  const double th = std::atan2(b.cs.y, b.cs.x);
+  const double phi_a = th + std::round((e.phi - th) / quarter) * quarter;
+  const double d = e.phi - phi_a;
+  const double plain = e.phi + std::clamp(-e.dg / e.ddg, -reach, reach);
+  if (!(p > 1.0) || d == 0.0 || std::abs(d) > kFlatReach) return plain;
+  const double sd = std::copysign(std::pow(std::abs(d), 1.0 / p), d);
+  const double s1 = sd - e.dg / (e.ddg * p * d / sd);
+  return phi_a + std::copysign(std::min(std::pow(std::abs(s1), p), reach), s1);
+}
+
+// The penetration depth: the minimum of g over phi from phi0, by Newton on g' = 0 (newton_angle)
+// kept inside a bracket [lo, hi] (g' < 0 at lo, > 0 at hi) once one is known; before that steps
+// of at most `reach`. A step leaving the bracket, or not halving the previous one, bisects it
+// instead. Converged: a Newton step of at most tol (rad), which is not taken.
+struct DepthSolve {
+  DepthEval e;
+  int iterations;
+  bool converged;
+};
+DepthSolve solve_depth(const Body& bi, const Body& bj, double phi0, double reach,
+                       const SolveOptions& opt) {
+  DepthSolve r{depth_at(bi, bj, phi0), 1, false};
+  double lo = 0.0, hi = 0.0, last = 2.0 * reach;
+  bool has_lo = false, has_hi = false;
+  while (r.iterations < opt.max_iter) {
+    const DepthEval& e = r.e;
+    if (e.dg < 0.0) lo = e.phi, has_lo = true;
+    if (e.dg > 0.0) hi = e.phi, has_hi = true;
+    double next = newton_angle(bi, bj, e, reach);
+    const double step = std::abs(next - e.phi);
+    if (e.dg == 0.0 || (step <= opt.tol && std::isfinite(e.ddg))) {
+      r.converged = true;
+      break;
+    }
+    if (has_lo && has_hi && (!((next - lo) * (next - hi) < 0.0) || step > 0.5 * last))
+      next = 0.5 * (lo + hi);
+    last = std::abs(next - e.phi);
+    r.e = depth_at(bi, bj, next);
+    ++r.iterations;
   }
-  return t;
+  return r;
 }
 
-// The contact's points, overlap, arms and radii from the normal n and the surface points.
-void finish_pair(const SuperEllipse& si, const SuperEllipse& sj, const Body& bi, const Body& bj,
-                 SuperPairContact& r) {
-  r.delta = dot(r.p_i - r.p_j, r.n);
-  r.point = 0.5 * (r.p_i + r.p_j);
-  r.arm_i = r.point - bi.c;
-  r.arm_j = r.point - bj.c;
-  r.rho_i = curvature_radius(si, to_body(r.p_i - bi.c, bi.cs));
-  r.rho_j = curvature_radius(sj, to_body(r.p_j - bj.c, bj.cs));
-}
-
-// A cold start: midway between the two support points (i's along u, j's against u) on the
-// direction u of least overlap among the line of centres and kColdDirections directions evenly
-// about it (a coarse separating-axis search). The line of centres alone can start deep inside
-// one elongated body, where the merit has stationary points other than the solution.
+// A cold start: the direction of least overlap of the support points among the line of centres
+// and kColdDirections directions evenly about it (a coarse separating-axis search: it lands in
+// the penetration depth's basin where a start on the line of centres alone can miss it for
+// elongated bodies).
 constexpr int kColdDirections = 16;
-Vec2 cold_start(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
-                const SuperPose& pj, Vec2 dn) {
-  Vec2 best{};
-  double least = 0.0;
+double cold_direction(const Body& bi, const Body& bj, Vec2 dn) {
+  const double phi_dn = std::atan2(dn.y, dn.x);
+  double best = phi_dn, least = 0.0;
   for (int k = 0; k < kColdDirections; ++k) {
-    const double ang = 2.0 * std::numbers::pi * k / kColdDirections;
-    const Vec2 u = rotate(dn, ang);
-    const Vec2 a = support_lab(si, pi.centre, pi.theta, u);
-    const Vec2 b = support_lab(sj, pj.centre, pj.theta, -u);
+    const double phi = phi_dn + 2.0 * std::numbers::pi * k / kColdDirections;
+    const Vec2 u{std::cos(phi), std::sin(phi)};
+    const Vec2 a = bi.c + to_lab(support(*bi.s, to_body(u, bi.cs)), bi.cs);
+    const Vec2 b = bj.c + to_lab(support(*bj.s, to_body(-u, bj.cs)), bj.cs);
     const double overlap = dot(a - b, u);
-    if (k == 0 || overlap < least) least = overlap, best = 0.5 * (a + b);
+    if (k == 0 || overlap < least) least = overlap, best = phi;
   }
   return best;
 }
 
+// The midway point from x0: damped Newton (at most opt.max_iter steps), mu^2 first balancing the
+// gradients' lengths. Steps of at most a quarter of the smallest semi-axis: a longer one can leap
+// into a body's middle, where its gradient vanishes and the merit has a false minimum.
+Midway solve_midway(const Body& bi, const Body& bj, Vec2 x0, double L, const SolveOptions& opt,
+                    int& iterations) {
+  Midway m = midway_at(bi, bj, x0, 1.0, L);
+  const double gi2 = norm2(m.vi.g), gj2 = norm2(m.vj.g);
+  m = midway_at(bi, bj, x0, gj2 > 0.0 && gi2 > 0.0 ? std::sqrt(gi2 / gj2) : 1.0, L);
+  const double tol2 = opt.tol * opt.tol;
+  const SuperEllipse &si = *bi.s, &sj = *bj.s;
+  const double reach = 0.25 * std::min(std::min(si.a, si.b), std::min(sj.a, sj.b));
+  iterations = 0;
+  while (!(m.merit <= tol2) && iterations < opt.max_iter && damped_step(bi, bj, L, reach, m))
+    ++iterations;
+  return m;
+}
+
+// The contact from the penetration depth's solution: normal, support points, overlap, point,
+// arms and the capped curvature radii at the support points.
+void finish_pair(const Body& bi, const Body& bj, const DepthEval& e, SuperPairContact& r) {
+  r.n = e.u;
+  r.p_i = e.pi;
+  r.p_j = e.pj;
+  r.delta = e.g;
+  r.point = 0.5 * (r.p_i + r.p_j);
+  r.arm_i = r.point - bi.c;
+  r.arm_j = r.point - bj.c;
+  r.rho_i = capped_inverse(e.kappa_i, radius_cap(*bi.s));
+  r.rho_j = capped_inverse(e.kappa_j, radius_cap(*bj.s));
+}
+
 }  // namespace
 
+// Warm: the midway point from the earlier one, then the depth from its normal. Cold: the depth
+// from the coarse search, then the midway point from the middle of the support points (near it:
+// the midway point lies within the overlap).
 SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                               const SuperPose& pj, const Vec2* warm, const SolveOptions& opt) {
   SuperPairContact r;
@@ -409,32 +530,89 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
   const Body bj{&sj, pj.centre, angle_cs(pj.theta)};
   const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
   const double L = 0.5 * (Ri + Rj);
-  // Start: the warm point, else the cold start below; mu^2 balances the gradients' lengths.
-  const Vec2 x0 = warm ? *warm : cold_start(si, pi, sj, pj, dn);
-  Midway m = midway_at(bi, bj, x0, 1.0, L);
-  const double gi2 = norm2(m.vi.g), gj2 = norm2(m.vj.g);
-  m = midway_at(bi, bj, x0, gj2 > 0.0 && gi2 > 0.0 ? std::sqrt(gi2 / gj2) : 1.0, L);
   const double tol2 = opt.tol * opt.tol;
-  // Steps of at most a quarter of the smallest semi-axis: a longer one can leap into a body's
-  // middle, where its gradient vanishes and the merit has a false minimum.
-  const double reach = 0.25 * std::min(std::min(si.a, si.b), std::min(sj.a, sj.b));
-  while (!(m.merit <= tol2) && r.iterations < opt.max_iter && damped_step(bi, bj, L, reach, m))
-    ++r.iterations;
-  r.converged = m.merit <= tol2;
-  if (r.converged) {
-    r.midway = m.x;
-    r.mu = std::sqrt(m.lam);
-    r.n = (1.0 / norm(m.vi.g)) * m.vi.g;
-    r.p_i = m.x + surface_along(bi, m.x, r.n) * r.n;
-    r.p_j = m.x + surface_along(bj, m.x, r.n) * r.n;
-  } else {  // the line of centres and the support points along it
-    r.n = dn;
-    r.p_i = support_lab(si, pi.centre, pi.theta, dn);
-    r.p_j = support_lab(sj, pj.centre, pj.theta, -dn);
-    r.midway = 0.5 * (r.p_i + r.p_j);
+  const double reach = std::numbers::pi / kColdDirections;
+  Midway m{};
+  DepthSolve depth{};
+  if (warm) {
+    m = solve_midway(bi, bj, *warm, L, opt, r.iterations);
+    const bool ok = m.merit <= tol2 && norm2(m.vi.g) > 0.0;
+    const double phi0 = ok ? std::atan2(m.vi.g.y, m.vi.g.x) : cold_direction(bi, bj, dn);
+    depth = solve_depth(bi, bj, phi0, reach, opt);
+  } else {
+    depth = solve_depth(bi, bj, cold_direction(bi, bj, dn), reach, opt);
+    m = solve_midway(bi, bj, 0.5 * (depth.e.pi + depth.e.pj), L, opt, r.iterations);
   }
-  finish_pair(si, sj, bi, bj, r);
+  r.midway_converged = m.merit <= tol2;
+  r.midway = m.x;
+  r.mu = std::sqrt(m.lam);
+  r.depth_iterations = depth.iterations;
+  r.converged = depth.converged;
+  finish_pair(bi, bj, depth.e, r);
   return r;
+}
+
+// ---- A segment (after the pair: its ends use the pair's 1D minimisation) ----------------------
+
+namespace {
+
+// Past the segment's end e (t_out: along the segment, out of it at e): the body against the end
+// alone, o_e(u) = h(u) - u . e minimised over the angle of u from the face's normal -m, downhill
+// (away from t_out: the deepest point lies past e), by the pair's 1D minimisation with e as a
+// body of no size. Kept if its normal stays on e's side (u . t_out <= 0), else `face`.
+SuperWallContact past_an_end(const SuperEllipse& s, Vec2 centre, double theta, Vec2 e, Vec2 m,
+                             Vec2 t_out, const SuperWallContact& face, const SolveOptions& opt) {
+  const Body body{&s, centre, angle_cs(theta)};
+  const Body end{nullptr, e, {1.0, 0.0}};
+  const double reach = 0.125 * std::numbers::pi;
+  const DepthSolve d = solve_depth(body, end, std::atan2(-m.y, -m.x), reach, opt);
+  if (!(dot(d.e.u, t_out) <= 0.0) || !(d.e.g < face.contact.g.delta)) {
+    SuperWallContact r = face;
+    r.iterations = d.iterations;
+    r.converged = d.converged;
+    return r;
+  }
+  SuperWallContact r;
+  r.contact.g = {d.e.g, d.e.u, e};
+  r.contact.arm = d.e.pi - centre;
+  r.contact.r_eff = capped_inverse(d.e.kappa_i, radius_cap(s));
+  r.iterations = d.iterations;
+  r.converged = d.converged;
+  return r;
+}
+
+}  // namespace
+
+// The penetration depth of the body and the segment: the minimum over directions u (from the body
+// to the wall) of max(o_a(u), o_b(u)), o_e(u) = h(u) - u . e the body's overlap with the end e
+// along u (h its support function). o_a - o_b = u . (b - a): o_b is the larger where u . t <= 0 (t
+// from a to b), o_a where u . t >= 0, and they meet at u = -m, where both are the face's overlap -h
+// (the wall's side is the one away from the body's centre: u = +m is left out). When the deepest
+// point along -m projects onto the segment, -m is a local minimum: the face's contact (the disc's
+// case). Past an end e the overlap falls from -m into e's half: its minimum there (past_an_end). A
+// thin tilted body crossing the segment near its end this way has a positive overlap though the
+// end's own point contact (nearest point) can read as no contact.
+SuperWallContact contact_segment(const SuperEllipse& s, Vec2 centre, double theta, Vec2 a, Vec2 b,
+                                 const SolveOptions& opt) {
+  const Vec2 ab = b - a;
+  const double len2 = norm2(ab);
+  if (!(len2 > 0.0)) return contact_point(s, centre, theta, a, opt);
+  const double len = std::sqrt(len2);
+  const Vec2 t = (1.0 / len) * ab;
+  Vec2 m = perp(t);  // the line's unit normal on the body's side
+  if (dot(m, centre - a) < 0.0) m = -m;
+  // The deepest point beyond the line: the support point along -m (towards the wall).
+  const Vec2 cs = angle_cs(theta);
+  const Vec2 pb = support(s, to_body(-m, cs));
+  const Vec2 p = centre + to_lab(pb, cs);
+  const double along = dot(p - a, t);
+  const double h = dot(p - a, m);  // < 0 beyond the line
+  if (along >= 0.0 && along <= len) return make_wall_contact(s, centre, p, pb, -m, -h, p - h * m);
+  // Past an end: the face's candidate acts at that end (its point on the wall), at the depth -h.
+  const Vec2 e = along < 0.0 ? a : b;
+  SuperWallContact face = make_wall_contact(s, centre, p, pb, -m, -h, e);
+  face.contact.arm = e + h * m - centre;  // the wall point + delta n
+  return past_an_end(s, centre, theta, e, m, along < 0.0 ? -t : t, face, opt);
 }
 
 }  // namespace dem2d
