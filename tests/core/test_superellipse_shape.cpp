@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <numbers>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "core/shape/superellipse_shape.hpp"
 #include "core/step/energy_ledger.hpp"
 #include "support/scenes.hpp"
+#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
@@ -478,6 +480,33 @@ TEST(SuperEllipseShape, ARunOfEllipsesTwiceGivesTheSameBits) {
   }
   EXPECT_GT(one.neighbor_builds(), 1);
   EXPECT_GT(one.last_totals().contacts, 10) << "they settled into a heap";
+}
+
+// The cost per particle-step of ellipses (aspect 0.6) against discs of the same bounding radius
+// in the same drum scene (400 bodies, 1 rad/s), after 0.5 s of settling: processor time per
+// particle-step, a measurement run by
+// hand (--gtest_also_run_disabled_tests --gtest_filter=*Cost*).
+TEST(SuperEllipseShape, DISABLED_CostPerParticleStepInADrum) {
+  for (const bool shaped : {false, true}) {
+    const Scene s = testing_support::shaped_drum_scene(400, 0.6, 1.0, shaped);
+    Simulation sim(s);
+    while (sim.time() < 0.5) sim.step();
+    SuperEllipseShape::reset_stats();
+    const int steps = 20000;
+    // Processor time, not wall time: the machine may be shared.
+    const std::clock_t t0 = std::clock();
+    for (int n = 0; n < steps; ++n) sim.step();
+    const double sec = static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC;
+    const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
+    std::printf("%s: %.3g us per particle-step (%zu bodies, %lld contacts at the end; %.1f pair "
+                "and %.1f wall solves per step, %.2f Newton steps each, %lld unconverged)\n",
+                s.title.c_str(), 1e6 * sec / (steps * static_cast<double>(s.particles.size())),
+                s.particles.size(), static_cast<long long>(sim.last_totals().contacts),
+                static_cast<double>(st.pair_solves) / steps,
+                static_cast<double>(st.wall_solves) / steps,
+                static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
+                static_cast<long long>(st.pair_unconverged));
+  }
 }
 
 }  // namespace
