@@ -632,8 +632,8 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
 // Ellipses (the superellipse's kernel, its midway points kept as history) in a drum at 6 rad/s,
 // crossing sectors: angles and shape fields ride with the ghosts and migrations.
 TEST(Reproducibility, EllipsesInADrum) {
-  Scene s = testing_support::shaped_drum_scene(160, 0.6, 6.0, true);
-  expect_same_as_serial(s, 30000, 3000);
+  Scene s = testing_support::shaped_drum_scene(100, 0.6, 6.0, true);
+  expect_same_as_serial(s, 20000, 2000);
 }
 
 TEST(Reproducibility, IterativeIntegratorCentrifuging) {
