@@ -398,6 +398,7 @@ void read_particles(const Reader& in, const Scene& scene, Resumption& r) {
   ParticleStore layout;  // the fields this scene's particles carry
   if (scene.breakage.present) layout.enable_damage();
   if (scene.drum.present) layout.enable_last_contact();
+  if (has_shaped_particles(scene)) layout.enable_shape();
   r.n_particles = static_cast<std::size_t>(in.shape("/particles/id")[0]);
   for (const FieldBase* f : layout.fields()) {
     const std::string name = "/particles/" + f->name();
@@ -471,6 +472,7 @@ void check_resumption(const Reader& in, const Scene& scene, const Resumption& r)
   ParticleStore layout;
   if (scene.breakage.present) layout.enable_damage();
   if (scene.drum.present) layout.enable_last_contact();
+  if (has_shaped_particles(scene)) layout.enable_shape();
   if (const std::string problem = resumption_problem(scene, layout, r); !problem.empty())
     in.fail(problem);
   for (std::size_t f = 0; f < layout.fields().size(); ++f) {

@@ -86,6 +86,11 @@ TEST(Resume, WithoutTheHistoriesTheRunDiffers) {
   EXPECT_GT(moved, 10);
 }
 
+// Ellipses (the store's shape fields, the superellipse's warm-start slots in the histories).
+TEST(Resume, EllipsesContinueBitForBit) {
+  check_resume(testing_support::shaped_drum_scene(100, 0.6, 1.0, true), 0.12, 0.15);
+}
+
 TEST(Resume, IterativeDrumContinuesBitForBit) {
   Scene s = thesis_drum_scene(60, 1.8, 16, 0.1);
   s.run.integrator = IntegratorKind::kIterative;

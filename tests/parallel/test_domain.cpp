@@ -629,6 +629,13 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
   expect_same_as_serial(s, 20000, 2000);
 }
 
+// Ellipses (the superellipse's kernel, its midway points kept as history) in a drum at 6 rad/s,
+// crossing sectors: angles and shape fields ride with the ghosts and migrations.
+TEST(Reproducibility, EllipsesInADrum) {
+  Scene s = testing_support::shaped_drum_scene(100, 0.6, 6.0, true);
+  expect_same_as_serial(s, 20000, 2000);
+}
+
 TEST(Reproducibility, IterativeIntegratorCentrifuging) {
   Scene s = thesis_drum(120, 10.0, 8);
   s.title = "centrifuging charge, iterative integrator";

@@ -1,6 +1,7 @@
 // Shared test fixtures: the thesis's steel (its Table 1) and its drum.
 #pragma once
 
+#include <cstdint>
 #include <random>
 #include <string>
 
@@ -44,6 +45,45 @@ inline Scene thesis_drum_scene(int balls, double speed, int sides, double ramp_t
   f.radius_min = f.radius_max = 0.1;
   f.region = FillRegion::kBottom;
   s.fills.push_back(f);
+  return s;
+}
+
+// The thesis drum (a circle, `speed` rad/s after a 0.1 s ramp) holding `count` steel bodies of
+// bounding radius 0.1 m on a square grid from the bottom up (0.21 m apart), each an ellipse of
+// semi-axes 0.1 and `aspect` 0.1 m at a random angle (seeded), or (!shaped) a disc of radius
+// 0.1 m: the same scene for shapes and discs; each starts at a random velocity of up to 1 m/s
+// per component, so that they collide from the start. dt fixed at 1e-5 s.
+inline Scene shaped_drum_scene(int count, double aspect, double speed, bool shaped,
+                               std::uint32_t seed = 7) {
+  Scene s;
+  s.title = shaped ? "ellipses in the thesis drum" : "discs in the thesis drum";
+  s.deck_path = "test";
+  s.materials.push_back(thesis_steel());
+  s.run.dt_auto = false;
+  s.run.dt = 1e-5;
+  s.run.duration = 100.0;
+  s.drum.present = true;
+  s.drum.radius = 2.5;
+  s.drum.speed = speed;
+  s.drum.ramp_time = 0.1;
+  s.drum.material = "steel";
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> turn(0.0, 3.14159265358979);
+  const double r = 0.1, spacing = 0.21, inner = 2.5 - 1.05 * r;
+  for (double y = -inner; y < inner && static_cast<int>(s.particles.size()) < count; y += spacing)
+    for (double x = -inner; x < inner && static_cast<int>(s.particles.size()) < count;
+         x += spacing) {
+      if (x * x + y * y > inner * inner) continue;
+      const double vx = 2.0 * turn(rng) / 3.14159265358979 - 1.0;
+      const double vy = 2.0 * turn(rng) / 3.14159265358979 - 1.0;
+      ParticleSpec p = ball("steel", r, {x, y}, {vx, vy});
+      if (shaped) {
+        p.semi_a = r;
+        p.semi_b = aspect * r;
+        p.angle = turn(rng);
+      }
+      s.particles.push_back(p);
+    }
   return s;
 }
 

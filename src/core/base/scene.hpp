@@ -84,6 +84,9 @@ struct ContactSpec {
   // compressed stores), else one at a time. Both give the same bits; not a deck key: tests set
   // it to compare them.
   bool scalar_gather = false;
+  // Shaped particles in the scene (ParticleSpec::shaped): every particle goes through the
+  // superellipse's kernel (a disc as a = b = r, n = 2). Set by the core (active_contact).
+  bool shaped = false;
 };
 
 struct LifterSpec {
@@ -142,6 +145,14 @@ struct ParticleSpec {
   Vec2 velocity{0.0, 0.0};
   double spin = 0.0;  // rad/s, counter-clockwise positive
   int source_line = 0;
+  // A shaped particle (core/shape/superellipse.hpp), when semi_a > 0: |x/a|^n + |y/b|^n = 1 in
+  // its body frame, turned by `angle` (rad, counter-clockwise); `radius` is then ignored (the
+  // store's radius is the bounding circle). Not a deck key yet: set by tests and benchmarks.
+  double semi_a = 0.0;
+  double semi_b = 0.0;
+  double exponent = 2.0;
+  double angle = 0.0;
+  bool shaped() const { return semi_a > 0.0; }
 };
 
 struct WallSpec {
@@ -269,12 +280,20 @@ inline bool is_ore_scene(const Scene& s) {
   return s.breakage.present || s.feed.present || s.sieve.present;
 }
 
+// Whether any particle of the scene is a superellipse (ParticleSpec::shaped).
+inline bool has_shaped_particles(const Scene& s) {
+  for (const ParticleSpec& p : s.particles)
+    if (p.shaped()) return true;
+  return false;
+}
+
 // The contact models a scene runs: its [contact] with the trackers its tables ask for switched
 // on (breakage, which records the peak energy too; else the collision spectra's peak energy).
 inline ContactSpec active_contact(const Scene& s) {
   ContactSpec c = s.contact;
   c.track_breakage = s.breakage.present;
   c.track_peak_energy = s.contact.track_peak_energy || s.output.collision_spectra;
+  c.shaped = c.shaped || has_shaped_particles(s);
   return c;
 }
 

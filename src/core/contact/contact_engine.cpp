@@ -6,6 +6,7 @@
 #include <tuple>
 #include <type_traits>
 
+#include "core/base/errors.hpp"
 #include "core/contact/contact_models.hpp"
 
 namespace dem2d {
@@ -15,6 +16,10 @@ template <class Law>
 std::unique_ptr<ContactKernel> make_law_kernel(const ContactSpec& spec, const PairTable& table,
                                                RollingModelKind rolling_kind,
                                                IntegratorKind integrator);
+template <class Law>
+std::unique_ptr<ContactKernel> make_superellipse_law_kernel(const ContactSpec& spec,
+                                                            const PairTable& table,
+                                                            RollingModelKind rolling_kind);
 }  // namespace kernels
 
 // The model is chosen here, once: one kernel per (law, rolling model, tracker, stepper), each
@@ -28,6 +33,16 @@ std::unique_ptr<ContactKernel> make_contact_kernel(const ContactSpec& spec, cons
   for (int a = 0; a < table.n_materials(); ++a)
     for (int b = 0; b < table.n_materials(); ++b) rolling_friction |= table(a, b).mu_r != 0.0;
   const RollingModelKind rolling_kind = rolling_friction ? spec.rolling : RollingModelKind::kNone;
+  // Shaped particles: the superellipse's kernel for every particle (a disc as a = b = r, n = 2),
+  // made for the Hertz-Mindlin law without trackers and with the as-seen integrators only.
+  if (spec.shaped) {
+    if (spec.model != ContactModelKind::kHertzMindlin || spec.track_breakage ||
+        spec.track_peak_energy || integrator == IntegratorKind::kIterative)
+      throw InputError(
+          "shaped particles run with the hertz-mindlin law only, without breakage, collision "
+          "spectra or the iterative integrator");
+    return kernels::make_superellipse_law_kernel<HertzMindlin>(spec, table, rolling_kind);
+  }
   std::unique_ptr<ContactKernel> out;
   [&]<class... Laws>(std::type_identity<std::tuple<Laws...>>) {
     static_cast<void>(

@@ -19,6 +19,7 @@
 #include "core/contact/contact_models.hpp"
 #include "core/fast/pair_gather.hpp"
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse.hpp"
 
 namespace dem2d::kernels {
 
@@ -88,6 +89,9 @@ class Kernel final : public ContactKernel {
   static_assert(!Shape::kArmsAlongNormal || kShapeWidth == 0,
                 "a shape with history of its own takes the general path (kArmsAlongNormal false)");
   static constexpr bool kArmsApart = !Shape::kArmsAlongNormal;
+  // The shape reads each body's semi-axes and exponent (the store's shape fields).
+  static constexpr bool kSemiAxes = kShapeHasSemiAxes<Shape>;
+  static_assert(!kSemiAxes || kArmsApart, "a shape with semi-axes takes the general path");
 
  public:
   Kernel(const ContactSpec& spec, const PairTable& table)
@@ -277,6 +281,12 @@ class Kernel final : public ContactKernel {
   Array<std::uint8_t> touch_;
   Array<ForceRecord> records_;
   bool prefetch_scatter_ = false;  // scatter_pairs fetches the partners' lines ahead
+  // With kSemiAxes: each batch contact's a_i, b_i, n_i, a_j, b_j, n_j (else never sized).
+  std::array<Array<double>, 6> forms_;
+  // Body i's form for the shape's wall (kSemiAxes).
+  static SuperEllipse form_of(const ParticleStore& p, std::size_t i) {
+    return {(*p.semi_a())[i], (*p.semi_b())[i], (*p.exponent())[i]};
+  }
 };
 
 }  // namespace dem2d::kernels

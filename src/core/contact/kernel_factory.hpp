@@ -9,6 +9,7 @@
 #include "core/contact/kernel_pairs.hpp"
 #include "core/contact/kernel_release.hpp"
 #include "core/contact/kernel_walls.hpp"
+#include "core/shape/superellipse_shape.hpp"
 
 namespace dem2d::kernels {
 
@@ -47,6 +48,25 @@ std::unique_ptr<ContactKernel> make_law_kernel(const ContactSpec& spec, const Pa
     if (spec.track_peak_energy)
       return make_kernel<Law, Rolling, TrackPeakEnergy>(spec, table, integrator);
     return make_kernel<Law, Rolling, TrackNone>(spec, table, integrator);
+  });
+}
+
+}  // namespace dem2d::kernels
+
+namespace dem2d::kernels {
+
+// The superellipse's kernels (core/shape/superellipse_shape.hpp): one law's rolling models with
+// the as-seen stepper and no tracker. Each is a scalar narrow phase of its own, so only the
+// Hertz-Mindlin law is instantiated (kernels_superellipse.cpp); the trackers and the iterative
+// integrator are refused (make_superellipse_kernel).
+template <class Law>
+std::unique_ptr<ContactKernel> make_superellipse_law_kernel(const ContactSpec& spec,
+                                                            const PairTable& table,
+                                                            RollingModelKind rolling_kind) {
+  return pick<RollingModels>(rolling_kind, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
+    using Rolling = typename decltype(rolling)::type;
+    return std::make_unique<
+        Kernel<ContactModel<Law, Rolling, TrackNone, StepAsSeen>, SuperEllipseShape>>(spec, table);
   });
 }
 

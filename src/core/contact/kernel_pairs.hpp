@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/contact/contact_kernel.hpp"
 
@@ -16,6 +17,12 @@ namespace dem2d::kernels {
 template <class Model, class Shape>
 void Kernel<Model, Shape>::prepare_pairs([[maybe_unused]] ParticleStore& p, PairList& pl) {
   b_.reserve(kChunk + kPackSize);
+  if constexpr (kSemiAxes) {
+    if (!p.shaped())
+      throw std::logic_error("a shape with semi-axes needs the store's shape fields");
+    if (forms_[0].size() < kChunk + kPackSize)
+      for (Array<double>& f : forms_) f.resize(kChunk + kPackSize);
+  }
   if (bi_.size() < kChunk + kPackSize) {
     bi_.resize(kChunk + kPackSize);
     bj_.resize(kChunk + kPackSize);
@@ -116,7 +123,16 @@ std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList&
                            .w_i = b_.w_i.data(),
                            .w_j = b_.w_j.data(),
                            .th_i = b_.th_i.data(),
-                           .th_j = b_.th_j.data()};
+                           .th_j = b_.th_j.data(),
+                           .semi_a = kSemiAxes ? p.semi_a()->data() : nullptr,
+                           .semi_b = kSemiAxes ? p.semi_b()->data() : nullptr,
+                           .exponent = kSemiAxes ? p.exponent()->data() : nullptr,
+                           .a_i = forms_[0].data(),
+                           .b_i = forms_[1].data(),
+                           .n_i = forms_[2].data(),
+                           .a_j = forms_[3].data(),
+                           .b_j = forms_[4].data(),
+                           .n_j = forms_[5].data()};
   std::size_t n = 0;
 #if DEM2D_VECTOR_GATHER
   if (vector_gather_) n = gather_contacts_vector<W>(kin_.data(), cols, k0, k1);
@@ -137,6 +153,8 @@ std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList&
     b_.copy(c, n - 1);
     bi_[c] = bi_[n - 1];
     bj_[c] = bj_[n - 1];
+    if constexpr (kSemiAxes)
+      for (Array<double>& f : forms_) f[c] = f[n - 1];
   }
   return n;
 }
@@ -234,10 +252,17 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
     std::array<Pack, kShapeWidth> h_old, h_new;
     for (std::size_t s = 0; s < kShapeWidth; ++s)
       h_old[s] = load(b_.history.old[kModelWidth + s], c);
-    const PairContactT<Pack> g =
-        Shape::pair(PairInputT<Pack>{load(b_.dx, c), load(b_.dy, c), load(b_.dist2, c), ri, rj,
-                                     load(b_.th_i, c), load(b_.th_j, c)},
-                    h_old, h_new);
+    PairInputT<Pack> in{load(b_.dx, c),   load(b_.dy, c), load(b_.dist2, c), ri, rj,
+                        load(b_.th_i, c), load(b_.th_j, c)};
+    if constexpr (kSemiAxes) {
+      in.ai = load(forms_[0], c);
+      in.bi = load(forms_[1], c);
+      in.ni = load(forms_[2], c);
+      in.aj = load(forms_[3], c);
+      in.bj = load(forms_[4], c);
+      in.nj = load(forms_[5], c);
+    }
+    const PairContactT<Pack> g = Shape::pair(in, h_old, h_new);
     const PackMask touching = g.delta > zero;
     store(select(touching, load(b_.counted, c), zero), b_.counted, c);
     const Pack nx = g.nx, ny = g.ny;

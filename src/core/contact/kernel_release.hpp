@@ -25,10 +25,13 @@ template <class Model, class Shape>
     // The shape's geometry a step ago (angles before the drift dt w), its history as committed.
     std::array<double, kShapeWidth> h_old, h_new;
     for (std::size_t s = 0; s < kShapeWidth; ++s) h_old[s] = h[kModelWidth + s];
-    const PairContactT<double> g =
-        Shape::pair(PairInputT<double>{d_old.x, d_old.y, norm2(d_old), ri, rj,
-                                       p.theta[i] - dt * p.omega[i], p.theta[j] - dt * p.omega[j]},
-                    h_old, h_new);
+    PairInputT<double> in{d_old.x, d_old.y, norm2(d_old), ri, rj, p.theta[i] - dt * p.omega[i],
+                          p.theta[j] - dt * p.omega[j]};
+    if constexpr (kSemiAxes) {
+      const SuperEllipse si = form_of(p, i), sj = form_of(p, j);
+      in.ai = si.a, in.bi = si.b, in.ni = si.n, in.aj = sj.a, in.bj = sj.b, in.nj = sj.n;
+    }
+    const PairContactT<double> g = Shape::pair(in, h_old, h_new);
     released_ += Model::spring_energy(c, g.r_eff, g.delta, h);
   } else {
     const double delta_old = ri + rj - norm(d_old);
@@ -47,8 +50,12 @@ template <class Model, class Shape>
     // The shape's geometry now, taken back along the closing velocity of its contact point.
     std::array<double, kShapeWidth> h_old, h_new;
     for (std::size_t s = 0; s < kShapeWidth; ++s) h_old[s] = h[kModelWidth + s];
-    const WallContact wc =
-        Shape::wall(walls, element, p.pos[i], p.radius[i], p.theta[i], h_old, h_new);
+    WallContact wc;
+    if constexpr (kSemiAxes)
+      wc = Shape::wall(walls, element, p.pos[i], p.radius[i], p.theta[i], form_of(p, i), h_old,
+                       h_new);
+    else
+      wc = Shape::wall(walls, element, p.pos[i], p.radius[i], p.theta[i], h_old, h_new);
     const Vec2 v_rel = p.vel[i] + p.omega[i] * perp(wc.arm) - walls.velocity_at(e.body, wc.g.point);
     released_ += Model::spring_energy(c, wc.r_eff, wc.g.delta - dt * dot(v_rel, wc.g.n), h);
   } else {

@@ -50,8 +50,11 @@ std::size_t Kernel<Model, Shape>::gather_walls(const ParticleStore& p, const Wal
       // The shape's own geometry, arm and history (written here: the model's slots come in B).
       std::array<double, kShapeWidth> h_old, h_new;
       for (std::size_t s = 0; s < kShapeWidth; ++s) h_old[s] = old[k * W + kModelWidth + s];
-      const WallContact wc =
-          Shape::wall(walls, wl.element[k], x[i], r[i], p.theta[i], h_old, h_new);
+      WallContact wc;
+      if constexpr (kSemiAxes)
+        wc = Shape::wall(walls, wl.element[k], x[i], r[i], p.theta[i], form_of(p, i), h_old, h_new);
+      else
+        wc = Shape::wall(walls, wl.element[k], x[i], r[i], p.theta[i], h_old, h_new);
       if (!(wc.g.delta > 0.0)) continue;
       const Vec2 vw = walls.velocity_at(e.body, wc.g.point);
       for (std::size_t s = 0; s < kShapeWidth; ++s)

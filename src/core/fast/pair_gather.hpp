@@ -64,6 +64,17 @@ struct GatherColumns {
   double* w_j = nullptr;
   double* th_i = nullptr;
   double* th_j = nullptr;
+  // For a shape with semi-axes (kShapeHasSemiAxes), else null: the store's a, b, n, and each
+  // body's in the batch.
+  const double* semi_a = nullptr;
+  const double* semi_b = nullptr;
+  const double* exponent = nullptr;
+  double* a_i = nullptr;
+  double* b_i = nullptr;
+  double* n_i = nullptr;
+  double* a_j = nullptr;
+  double* b_j = nullptr;
+  double* n_j = nullptr;
 };
 
 // The candidates [k0, k1) in contact, packed into the columns from 0 on; returns their count.
@@ -119,6 +130,16 @@ inline void gather_frames_scalar(const GatherColumns& o, std::size_t c0, std::si
     o.w_j[c] = o.w[j];
     o.th_i[c] = o.theta[i];
     o.th_j[c] = o.theta[j];
+  }
+  if (o.semi_a == nullptr) return;
+  for (std::size_t c = c0; c < c1; ++c) {
+    const std::int32_t i = o.bi[c], j = o.bj[c];
+    o.a_i[c] = o.semi_a[i];
+    o.b_i[c] = o.semi_b[i];
+    o.n_i[c] = o.exponent[i];
+    o.a_j[c] = o.semi_a[j];
+    o.b_j[c] = o.semi_b[j];
+    o.n_j[c] = o.exponent[j];
   }
 }
 

@@ -41,6 +41,7 @@ Simulation::Simulation(const Scene& scene, Domain* domain, const Resumption* res
       sort_policy_(scene_.run.spatial_sort) {
   if (scene_.breakage.present) particles_.enable_damage();
   if (scene_.drum.present) particles_.enable_last_contact();
+  if (has_shaped_particles(scene_)) particles_.enable_shape();
   if (resume)
     load_particles(*resume);
   else
@@ -112,6 +113,8 @@ void Simulation::set_up_lists() {
   if (scene_.feed.present) r_max = std::max(r_max, scene_.feed.radius_max);
   halo_width_ = 2.0 * r_max + rebuilds_.skin();
   ghost_fields_ = {&particles_.pos, &particles_.vel, &particles_.omega};
+  // A shaped particle's contacts depend on its angle too.
+  if (particles_.shaped()) ghost_fields_.push_back(&particles_.theta);
 }
 
 // Every particle of the checkpoint, in id order (whatever order the ranks wrote them in).
@@ -540,7 +543,7 @@ SeriesRow Simulation::diagnostics() const {
   double ke = 0.0, re = 0.0, pe = 0.0;
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     ke += 0.5 * p.mass[k] * norm2(p.vel[k]);
-    re += Disc::rotational_energy(p.mass[k], p.radius[k], p.omega[k]);
+    re += rotational_energy(p, k);
     pe -= p.mass[k] * dot(gravity, p.pos[k]);
   }
   const EvaluationTotals& totals = contacts_.totals();

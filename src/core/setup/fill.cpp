@@ -269,8 +269,12 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   std::int64_t next_id = static_cast<std::int64_t>(store.size());
   for (const ParticleSpec& s : scene.particles) {
     const int mat = find_material(scene, s.material);
-    store.add(next_id++, mat, s.radius, scene.materials[mat].density, s.position, s.velocity,
-              s.spin);
+    if (s.shaped())
+      store.add_shaped(next_id++, mat, s.semi_a, s.semi_b, s.exponent,
+                       scene.materials[mat].density, s.position, s.velocity, s.spin, s.angle);
+    else
+      store.add(next_id++, mat, s.radius, scene.materials[mat].density, s.position, s.velocity,
+                s.spin);
   }
   double r_all_max = 0.0;
   for (std::size_t k = 0; k < store.size(); ++k) r_all_max = std::max(r_all_max, store.radius[k]);

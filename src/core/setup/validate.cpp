@@ -73,6 +73,7 @@ double fill_lattice_sites(const Scene& scene, std::size_t fill) {
 double particle_memory_bytes(const Scene& scene, double particles) {
   ParticleStore store;
   if (scene.breakage.present) store.enable_damage();
+  if (has_shaped_particles(scene)) store.enable_shape();
   // The contact histories' width: the slots the scene's contact model declares.
   Scene models;
   models.materials = scene.materials;

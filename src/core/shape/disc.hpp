@@ -42,12 +42,19 @@ struct PairContactT {
 // What the narrow phase of a shape without kArmsAlongNormal reads for two bodies i and j: the
 // centres' offset d = x_j - x_i (dist2 = |d|^2), their radii (bounding circles: the broad phase
 // and the gather's first test use them) and their angles.
+// A shape with semi-axes (kSemiAxes, the superellipse) reads each body's a, b and exponent n
+// too; other shapes leave them unset.
 template <class T>
 struct PairInputT {
   T dx, dy, dist2;
   T ri, rj;
   T th_i, th_j;
+  T ai{}, bi{}, ni{}, aj{}, bj{}, nj{};
 };
+
+// Whether a shape reads each body's semi-axes and exponent (PairInputT; its wall takes them).
+template <class Shape>
+inline constexpr bool kShapeHasSemiAxes = requires { requires Shape::kSemiAxes; };
 
 // Closest contact of a body with one wall element at the current time.
 struct WallGeometry {

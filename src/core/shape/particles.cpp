@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse.hpp"
 
 namespace dem2d {
 
@@ -37,6 +38,27 @@ void ParticleStore::enable_last_contact() {
   last_contact_->resize(size());
 }
 
+void ParticleStore::enable_shape() {
+  if (semi_a_) return;
+  semi_a_ = std::make_unique<Field<double>>(
+      "semi_axis_a", registry_,
+      FieldMeta{"m", "semi-axis a along the body's x (a disc: its radius)", true, true});
+  semi_b_ = std::make_unique<Field<double>>(
+      "semi_axis_b", registry_,
+      FieldMeta{"m", "semi-axis b along the body's y (a disc: its radius)", true, true});
+  exponent_ = std::make_unique<Field<double>>(
+      "exponent", registry_,
+      FieldMeta{"1", "superellipse exponent n (2: an ellipse or a disc)", true, true});
+  semi_a_->resize(size());
+  semi_b_->resize(size());
+  exponent_->resize(size());
+}
+
+double rotational_energy(const ParticleStore& p, std::size_t k) {
+  if (!p.shaped()) return Disc::rotational_energy(p.mass[k], p.radius[k], p.omega[k]);
+  return 0.5 * p.omega[k] * p.omega[k] / p.inv_inertia[k];
+}
+
 void ParticleStore::resize_all(std::size_t n) {
   for (FieldBase* f : registry_) f->resize(n);
 }
@@ -61,8 +83,29 @@ std::size_t ParticleStore::add(std::int64_t pid, std::int32_t mat, double r, dou
   inv_inertia[i] = 1.0 / Disc::inertia(m, r);
   force[i] = {};
   torque[i] = 0.0;
+  if (semi_a_) {  // a disc among shaped particles: the superellipse a = b = r, n = 2
+    (*semi_a_)[i] = r;
+    (*semi_b_)[i] = r;
+    (*exponent_)[i] = 2.0;
+  }
   n_owned_ = i + 1;
   layout_ = next_layout();
+  return i;
+}
+
+std::size_t ParticleStore::add_shaped(std::int64_t pid, std::int32_t mat, double a, double b,
+                                      double n, double density, Vec2 x, Vec2 v, double spin,
+                                      double angle) {
+  if (!semi_a_) throw std::logic_error("ParticleStore::add_shaped without enable_shape");
+  const SuperEllipse s{a, b, n};
+  const std::size_t i = add(pid, mat, bounding_radius(s), density, x, v, spin);
+  theta[i] = angle;
+  mass[i] = dem2d::mass(s, density);
+  inv_mass[i] = 1.0 / mass[i];
+  inv_inertia[i] = 1.0 / inertia_z(s, density);
+  (*semi_a_)[i] = a;
+  (*semi_b_)[i] = b;
+  (*exponent_)[i] = n;
   return i;
 }
 

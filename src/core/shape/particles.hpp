@@ -152,6 +152,19 @@ class ParticleStore {
   Field<double>* last_contact() { return last_contact_.get(); }
   const Field<double>* last_contact() const { return last_contact_.get(); }
   void enable_last_contact();
+  // Shaped particles (core/shape/superellipse.hpp, core/shape/superellipse_shape.hpp): each
+  // particle's semi-axes a, b and exponent n, registered only when a scene has shaped particles
+  // (a disc there is a = b = r, n = 2). Snapshots, checkpoints and migration carry them like any
+  // registered field. The `radius` of a shaped particle is its bounding circle (the broad phase
+  // uses it), `mass` and `inv_inertia` those of its superellipsoid.
+  Field<double>* semi_a() { return semi_a_.get(); }
+  const Field<double>* semi_a() const { return semi_a_.get(); }
+  Field<double>* semi_b() { return semi_b_.get(); }
+  const Field<double>* semi_b() const { return semi_b_.get(); }
+  Field<double>* exponent() { return exponent_.get(); }
+  const Field<double>* exponent() const { return exponent_.get(); }
+  bool shaped() const { return semi_a_ != nullptr; }
+  void enable_shape();
 
   std::size_t size() const { return id.size(); }
   std::size_t n_owned() const { return n_owned_; }
@@ -165,6 +178,10 @@ class ParticleStore {
   // Append an owned particle (no ghosts may be present). Returns its index.
   std::size_t add(std::int64_t pid, std::int32_t mat, double r, double density, Vec2 x, Vec2 v,
                   double spin);
+  // Append an owned superellipse |x/a|^n + |y/b|^n = 1 turned by `angle` (enable_shape first):
+  // radius the bounding circle, mass and inertia of the superellipsoid with c = min(a, b).
+  std::size_t add_shaped(std::int64_t pid, std::int32_t mat, double a, double b, double n,
+                         double density, Vec2 x, Vec2 v, double spin, double angle);
   // Append n owned particle slots (no ghosts may be present); returns the first index. The
   // caller fills every field (migration unpacks them).
   std::size_t add_owned(std::size_t n);
@@ -182,6 +199,11 @@ class ParticleStore {
   std::uint64_t layout_ = 0;
   std::unique_ptr<Field<double>> damage_;
   std::unique_ptr<Field<double>> last_contact_;
+  std::unique_ptr<Field<double>> semi_a_, semi_b_, exponent_;
 };
+
+// 1/2 I w^2 of particle k: the disc's formula in a store without shaped particles (its bits
+// unchanged), else from the stored inverse inertia.
+double rotational_energy(const ParticleStore& p, std::size_t k);
 
 }  // namespace dem2d

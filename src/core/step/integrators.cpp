@@ -126,6 +126,10 @@ StepOutcome VelocityVerlet::end_of_step_round(StepStages& s, const ClosingKick& 
   double reduce[2] = {local_ok ? 0.0 : 1.0, std::sqrt(c.disp2) + dt_ * std::sqrt(c.speed2)};
   Domain& domain = s.domain();
   if (domain.size() > 1) {
+    if (!next_theta_ && s.ghost_fields().size() > next_registry_.size()) {
+      next_theta_ = std::make_unique<Field<double>>("next_angle", next_registry_);
+      next_theta_->resize(next_pos_.size());
+    }
     prepare_ghosts_ahead(s.particles(), domain.halo_sources());
     domain.exchange_step(s.particles(), next_registry_, s.ghost_fields(), reduce);
     ghosts_ahead_ = true;
@@ -154,12 +158,14 @@ void VelocityVerlet::prepare_ghosts_ahead(const ParticleStore& p,
       next_pos_[k] = p.pos[k];
       next_vel_[k] = p.vel[k];
       next_omega_[k] = p.omega[k];
+      if (next_theta_) (*next_theta_)[k] = p.theta[k];
       continue;
     }
     const Drifted d = kick_drift(p.pos[k], p.vel[k], p.acc[k], p.omega[k], p.alpha[k], h, dt_);
     next_pos_[k] = d.x;
     next_vel_[k] = d.v;
     next_omega_[k] = d.w;
+    if (next_theta_) (*next_theta_)[k] = p.theta[k] + dt_ * d.w;  // as kick_drift_owned
   }
 }
 

@@ -206,6 +206,9 @@ class VelocityVerlet final : public Integrator {
   Field<Vec2> next_pos_{"next_position", next_registry_};
   Field<Vec2> next_vel_{"next_velocity", next_registry_};
   Field<double> next_omega_{"next_spin", next_registry_};
+  // The angle as well when the ghosts carry it (shaped particles: Simulation's ghost fields end
+  // with the angle), made at the first round that needs it.
+  std::unique_ptr<Field<double>> next_theta_;
 };
 
 // The thesis's iterative refinement: predict the state at t + dt with the jerk
