@@ -10,8 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <numbers>
 #include <vector>
 
@@ -100,8 +100,7 @@ struct MidwayDisc : Disc {
   static constexpr bool kArmsAlongNormal = false;
   static constexpr std::array<HistorySlot, 0> kHistory{};
   template <class T>
-  static PairContactT<T> pair(const PairInputT<T>& in, const std::array<T, 0>&,
-                              std::array<T, 0>&) {
+  static PairContactT<T> pair(const PairInputT<T>& in, const std::array<T, 0>&, std::array<T, 0>&) {
     PairContactT<T> g = Disc::pair(in.dx, in.dy, in.dist2, in.ri, in.rj);
     const T si = in.ri - 0.5 * g.delta, sj = in.rj - 0.5 * g.delta;
     g.aix = si * g.nx;
@@ -135,8 +134,8 @@ struct FixedCurvatureEllipse : SuperEllipseShape {
 };
 
 // Steel (or a softer steel-dense material: E given), a rigid floor or box of that material.
-Scene scene_of(double young, double restitution, double mu_s, double mu_r, double dt,
-               Vec2 gravity, RollingModelKind rolling = RollingModelKind::kNone) {
+Scene scene_of(double young, double restitution, double mu_s, double mu_r, double dt, Vec2 gravity,
+               RollingModelKind rolling = RollingModelKind::kNone) {
   Scene s = testing_support::contact_scene("superellipse shape", dt,
                                            ContactModelKind::kHertzMindlin, rolling, gravity);
   s.materials.push_back(make_material("steel", 7800.0, young, 0.25, restitution, mu_s, mu_r));
@@ -209,14 +208,15 @@ void expect_round_superellipses_are_discs(RollingModelKind rolling) {
     disc_gap.add(disc, shaped);
   }
   const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
-  std::printf("round superellipses: vs the midway disc |dF|/F %.3g, |dT|/T %.3g; vs the disc's "
-              "kernel |dF|/F %.3g, |dT|/T %.3g; %d pair steps, %d floor steps; %lld pair solves "
-              "(%lld unconverged, %.2f Newton steps each), %lld wall solves\n",
-              same.rel_force(), same.rel_torque(), disc_gap.rel_force(), disc_gap.rel_torque(),
-              pair_steps, wall_steps, static_cast<long long>(st.pair_solves),
-              static_cast<long long>(st.pair_unconverged),
-              static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
-              static_cast<long long>(st.wall_solves));
+  std::printf(
+      "round superellipses: vs the midway disc |dF|/F %.3g, |dT|/T %.3g; vs the disc's "
+      "kernel |dF|/F %.3g, |dT|/T %.3g; %d pair steps, %d floor steps; %lld pair solves "
+      "(%lld unconverged, %.2f Newton steps each), %lld wall solves\n",
+      same.rel_force(), same.rel_torque(), disc_gap.rel_force(), disc_gap.rel_torque(), pair_steps,
+      wall_steps, static_cast<long long>(st.pair_solves),
+      static_cast<long long>(st.pair_unconverged),
+      static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
+      static_cast<long long>(st.wall_solves));
   EXPECT_GT(same.max_force, 1.0) << "the bodies collided";
   EXPECT_GT(pair_steps, 10) << "the pair stayed in contact for a while";
   EXPECT_GT(wall_steps, 20) << "the floor contact lasted";
@@ -254,9 +254,10 @@ TEST(SuperEllipseShape, ARoundOneOnTheFloorIsTheDisc) {
     in_contact += disc.tot.contacts;
     gap.add(disc, shaped);
   }
-  std::printf("round superellipse on the floor vs the disc: |dF|/F %.3g, |dT|/T %.3g, %d steps "
-              "in contact, spin %.4f vs %.4f rad/s\n",
-              gap.rel_force(), gap.rel_torque(), in_contact, shaped.p.omega[0], disc.p.omega[0]);
+  std::printf(
+      "round superellipse on the floor vs the disc: |dF|/F %.3g, |dT|/T %.3g, %d steps "
+      "in contact, spin %.4f vs %.4f rad/s\n",
+      gap.rel_force(), gap.rel_torque(), in_contact, shaped.p.omega[0], disc.p.omega[0]);
   EXPECT_GT(in_contact, 10000);
   // The geometry differs in the last bits each step (the support point's powers), and 20000
   // steps of a stiff sustained contact carry that into the state: 2.7e-10 at the end.
@@ -290,8 +291,7 @@ TEST(SuperEllipseShape, TheStoreCarriesShapesAndTheirInertia) {
   EXPECT_NEAR(p.inv_inertia[2], p.inv_inertia[0], 1e-12 * p.inv_inertia[0]);
   // Rotational energy from each body's own inertia; a disc store's formula unchanged.
   EXPECT_NEAR(rotational_energy(p, 1), 0.5 * 9.0 / p.inv_inertia[1], 1e-15);
-  EXPECT_EQ(rotational_energy(disc_only, 0),
-            Disc::rotational_energy(disc_only.mass[0], 0.01, 3.0));
+  EXPECT_EQ(rotational_energy(disc_only, 0), Disc::rotational_energy(disc_only.mass[0], 0.01, 3.0));
   // The fields are registered ones: migration, checkpoints and snapshots carry them.
   int named = 0;
   for (const FieldBase* f : p.fields())
@@ -362,11 +362,11 @@ TEST(SuperEllipseShape, AnElasticEllipseInABoxKeepsItsEnergyOverManyImpacts) {
   double spin_range = 0.0;
   SuperEllipseShape::reset_stats();
   const double drift = box_energy_drift<FixedCurvatureEllipse>(1.5, impacts, spin_range);
-  std::printf("ellipse in a box, fixed R*: %d impacts in 1.5 s, max |E - E0| / E0 %.3g, spin "
-              "range %.1f rad/s, %lld wall solves (%lld unconverged)\n",
-              impacts, drift, spin_range,
-              static_cast<long long>(SuperEllipseShape::stats().wall_solves),
-              static_cast<long long>(SuperEllipseShape::stats().wall_unconverged));
+  std::printf(
+      "ellipse in a box, fixed R*: %d impacts in 1.5 s, max |E - E0| / E0 %.3g, spin "
+      "range %.1f rad/s, %lld wall solves (%lld unconverged)\n",
+      impacts, drift, spin_range, static_cast<long long>(SuperEllipseShape::stats().wall_solves),
+      static_cast<long long>(SuperEllipseShape::stats().wall_unconverged));
   EXPECT_GE(impacts, 40);
   EXPECT_GT(spin_range, 100.0) << "the impacts, off the centre, changed the spin";
   EXPECT_LT(drift, 2e-6);
@@ -381,9 +381,10 @@ TEST(SuperEllipseShape, AnElasticEllipseInABoxWithItsCurvatureKeepsItsEnergyToTh
   int impacts = 0;
   double spin_range = 0.0;
   const double drift = box_energy_drift<SuperEllipseShape>(1.5, impacts, spin_range);
-  std::printf("ellipse in a box, R* from the curvature: %d impacts in 1.5 s, max |E - E0| / E0 "
-              "%.3g\n",
-              impacts, drift);
+  std::printf(
+      "ellipse in a box, R* from the curvature: %d impacts in 1.5 s, max |E - E0| / E0 "
+      "%.3g\n",
+      impacts, drift);
   EXPECT_GE(impacts, 40);
   EXPECT_LT(drift, 2e-2);
 }
@@ -404,14 +405,15 @@ TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictio
     if (in_contact > 0 && sim.last_totals().contacts == 0) break;
   }
   const double m = p.mass[0], scale = m * 0.05 * 1.0 + 30.0 / p.inv_inertia[0];
-  std::printf("frictional impact: %d steps in contact, dp/(m) = %.3g %.3g, dL/scale = %.3g, "
-              "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f Newton steps each)\n",
-              in_contact, (momentum(p).x - p0.x) / m, (momentum(p).y - p0.y) / m,
-              (angular_momentum(p) - l0) / scale, kinetic(sim) / e0,
-              static_cast<long long>(SuperEllipseShape::stats().pair_solves),
-              static_cast<long long>(SuperEllipseShape::stats().pair_unconverged),
-              static_cast<double>(SuperEllipseShape::stats().pair_iterations) /
-                  std::max<double>(1.0, SuperEllipseShape::stats().pair_solves));
+  std::printf(
+      "frictional impact: %d steps in contact, dp/(m) = %.3g %.3g, dL/scale = %.3g, "
+      "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f Newton steps each)\n",
+      in_contact, (momentum(p).x - p0.x) / m, (momentum(p).y - p0.y) / m,
+      (angular_momentum(p) - l0) / scale, kinetic(sim) / e0,
+      static_cast<long long>(SuperEllipseShape::stats().pair_solves),
+      static_cast<long long>(SuperEllipseShape::stats().pair_unconverged),
+      static_cast<double>(SuperEllipseShape::stats().pair_iterations) /
+          std::max<double>(1.0, SuperEllipseShape::stats().pair_solves));
   ASSERT_GT(in_contact, 20);
   EXPECT_NEAR(momentum(p).x, p0.x, 1e-13 * m);
   EXPECT_NEAR(momentum(p).y, p0.y, 1e-13 * m);
@@ -436,9 +438,10 @@ TEST(SuperEllipseShape, ATiltedEllipseDroppedOnAFloorRestsOnItsFlatSide) {
   while (sim.time() < 2.0) sim.step();
   const double turns = p.theta[0] / std::numbers::pi;
   const double off = std::abs(turns - std::round(turns)) * std::numbers::pi;
-  std::printf("dropped ellipse at t = %.2f s: height %.6f m (b = %.3f), angle off horizontal "
-              "%.2e rad, speed %.2e m/s, spin %.2e rad/s\n",
-              sim.time(), p.pos[0].y, b, off, norm(p.vel[0]), p.omega[0]);
+  std::printf(
+      "dropped ellipse at t = %.2f s: height %.6f m (b = %.3f), angle off horizontal "
+      "%.2e rad, speed %.2e m/s, spin %.2e rad/s\n",
+      sim.time(), p.pos[0].y, b, off, norm(p.vel[0]), p.omega[0]);
   EXPECT_NEAR(p.pos[0].y, b, 1e-3 * b);  // less its overlap under its weight (2e-6 m)
   EXPECT_LT(off, 1e-2);
   EXPECT_LT(norm(p.vel[0]), 1e-9);
@@ -498,14 +501,14 @@ TEST(SuperEllipseShape, DISABLED_CostPerParticleStepInADrum) {
     for (int n = 0; n < steps; ++n) sim.step();
     const double sec = static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC;
     const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
-    std::printf("%s: %.3g us per particle-step (%zu bodies, %lld contacts at the end; %.1f pair "
-                "and %.1f wall solves per step, %.2f Newton steps each, %lld unconverged)\n",
-                s.title.c_str(), 1e6 * sec / (steps * static_cast<double>(s.particles.size())),
-                s.particles.size(), static_cast<long long>(sim.last_totals().contacts),
-                static_cast<double>(st.pair_solves) / steps,
-                static_cast<double>(st.wall_solves) / steps,
-                static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
-                static_cast<long long>(st.pair_unconverged));
+    std::printf(
+        "%s: %.3g us per particle-step (%zu bodies, %lld contacts at the end; %.1f pair "
+        "and %.1f wall solves per step, %.2f Newton steps each, %lld unconverged)\n",
+        s.title.c_str(), 1e6 * sec / (steps * static_cast<double>(s.particles.size())),
+        s.particles.size(), static_cast<long long>(sim.last_totals().contacts),
+        static_cast<double>(st.pair_solves) / steps, static_cast<double>(st.wall_solves) / steps,
+        static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
+        static_cast<long long>(st.pair_unconverged));
   }
 }
 

@@ -252,7 +252,7 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
     std::array<Pack, kShapeWidth> h_old, h_new;
     for (std::size_t s = 0; s < kShapeWidth; ++s)
       h_old[s] = load(b_.history.old[kModelWidth + s], c);
-    PairInputT<Pack> in{load(b_.dx, c),   load(b_.dy, c), load(b_.dist2, c), ri, rj,
+    PairInputT<Pack> in{load(b_.dx, c),   load(b_.dy, c),  load(b_.dist2, c), ri, rj,
                         load(b_.th_i, c), load(b_.th_j, c)};
     if constexpr (kSemiAxes) {
       in.ai = load(forms_[0], c);

@@ -25,7 +25,12 @@ template <class Model, class Shape>
     // The shape's geometry a step ago (angles before the drift dt w), its history as committed.
     std::array<double, kShapeWidth> h_old, h_new;
     for (std::size_t s = 0; s < kShapeWidth; ++s) h_old[s] = h[kModelWidth + s];
-    PairInputT<double> in{d_old.x, d_old.y, norm2(d_old), ri, rj, p.theta[i] - dt * p.omega[i],
+    PairInputT<double> in{d_old.x,
+                          d_old.y,
+                          norm2(d_old),
+                          ri,
+                          rj,
+                          p.theta[i] - dt * p.omega[i],
                           p.theta[j] - dt * p.omega[j]};
     if constexpr (kSemiAxes) {
       const SuperEllipse si = form_of(p, i), sj = form_of(p, j);

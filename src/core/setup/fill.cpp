@@ -270,8 +270,8 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   for (const ParticleSpec& s : scene.particles) {
     const int mat = find_material(scene, s.material);
     if (s.shaped())
-      store.add_shaped(next_id++, mat, s.semi_a, s.semi_b, s.exponent,
-                       scene.materials[mat].density, s.position, s.velocity, s.spin, s.angle);
+      store.add_shaped(next_id++, mat, s.semi_a, s.semi_b, s.exponent, scene.materials[mat].density,
+                       s.position, s.velocity, s.spin, s.angle);
     else
       store.add(next_id++, mat, s.radius, scene.materials[mat].density, s.position, s.velocity,
                 s.spin);

@@ -54,7 +54,9 @@ struct PairInputT {
 
 // Whether a shape reads each body's semi-axes and exponent (PairInputT; its wall takes them).
 template <class Shape>
-inline constexpr bool kShapeHasSemiAxes = requires { requires Shape::kSemiAxes; };
+inline constexpr bool kShapeHasSemiAxes = requires {
+  requires Shape::kSemiAxes;
+};
 
 // Closest contact of a body with one wall element at the current time.
 struct WallGeometry {

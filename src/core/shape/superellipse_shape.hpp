@@ -73,8 +73,8 @@ struct SuperEllipseShape {
   // One pair of bodies: i at the origin, j at d = (dx, dy). Lanes out of contact (bounding
   // circles apart, or bodies apart) return delta <= 0 and zero history.
   static PairContactT<double> pair_one(double dx, double dy, double th_i, double th_j,
-                                       const SuperEllipse& si, const SuperEllipse& sj,
-                                       double h0, double h1, double& f0, double& f1) {
+                                       const SuperEllipse& si, const SuperEllipse& sj, double h0,
+                                       double h1, double& f0, double& f1) {
     PairContactT<double> g{};
     f0 = f1 = 0.0;
     // The cheap test first: the two support points along the line of centres. Apart along that

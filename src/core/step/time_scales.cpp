@@ -106,9 +106,9 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   // A shaped particle counts as the sphere of its smaller semi-axis (lighter than it, so its
   // contact times are shorter; its curvature radii are not looked at).
   for (std::size_t k = 0; k < p.n_owned(); ++k)
-    r_min[p.material[k]] = std::min(
-        r_min[p.material[k]],
-        p.shaped() ? std::min((*p.semi_a())[k], (*p.semi_b())[k]) : p.radius[k]);
+    r_min[p.material[k]] =
+        std::min(r_min[p.material[k]],
+                 p.shaped() ? std::min((*p.semi_a())[k], (*p.semi_b())[k]) : p.radius[k]);
   // Ore scenes: the smallest particle the run can make, from the start (the dt stays safe as
   // fragments get small): a fragment of the smallest breakable particle, and the smallest fed.
   if (scene.breakage.present) {
