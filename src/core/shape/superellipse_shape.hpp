@@ -80,7 +80,7 @@ struct SuperEllipseShape {
     // The cheap test first: the two support points along the line of centres. Apart along that
     // axis, the bodies are apart (a third of the candidates of a drum of ellipses, each spared
     // the Newton solve).
-    const double dist = std::sqrt(dx * dx + dy * dy);
+    const double dist = std::sqrt(rounded(dx * dx) + rounded(dy * dy));
     if (dist > 0.0) {
       const Vec2 u{dx / dist, dy / dist};
       const double reach = dot(support_lab(si, {0.0, 0.0}, th_i, u), u) +
@@ -96,7 +96,7 @@ struct SuperEllipseShape {
     const double ci = std::cos(th_i), sn = std::sin(th_i);
     Vec2 warm{};
     const bool have_warm = h0 != 0.0 || h1 != 0.0;
-    if (have_warm) warm = {ci * h0 - sn * h1, sn * h0 + ci * h1};
+    if (have_warm) warm = rotate(Vec2{h0, h1}, Vec2{ci, sn});
     const SuperPairContact c = contact_pair(si, SuperPose{{0.0, 0.0}, th_i}, sj,
                                             SuperPose{{dx, dy}, th_j}, have_warm ? &warm : nullptr);
     g.delta = c.delta;
@@ -120,8 +120,9 @@ struct SuperEllipseShape {
     g.arm_i = norm(c.arm_i);
     g.arm_j = norm(c.arm_j);
     if (c.converged) {  // the midway point into i's body frame
-      f0 = ci * c.midway.x + sn * c.midway.y;
-      f1 = -sn * c.midway.x + ci * c.midway.y;
+      const Vec2 body = rotate(c.midway, Vec2{ci, -sn});
+      f0 = body.x;
+      f1 = body.y;
     }
     return g;
   }
