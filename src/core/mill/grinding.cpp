@@ -47,7 +47,7 @@ Grinding::Grinding(const Scene& scene, const ParticleStore& p, const Domain& dom
   // The ore at the start, by size (exact integers summed over ranks).
   const int ore = ore_material();
   for (std::size_t k = 0; k < p.n_owned(); ++k)
-    if (p.material[k] == ore) sizes_.initial.add(2.0 * p.radius[k], p.mass[k]);
+    if (p.material[k] == ore) sizes_.initial.add(2.0 * size_radius(p, k), p.mass[k]);
   combine(sizes_.initial, domain);
   if (scene.sieve.present && scene.sieve.type == DischargeType::kGrate)
     grate_inner_ = DrumGeometry(scene.drum).inner_radius() - scene.sieve.grate_width;
@@ -140,7 +140,7 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
     for (std::size_t k = 0; k < p.n_owned(); ++k)
       if (remove[k] == 1) {
         ledger.discharged += mechanical_energy(p, k, scene_.run.gravity);
-        sizes_.product.add(2.0 * p.radius[k], p.mass[k]);
+        sizes_.product.add(2.0 * size_radius(p, k), p.mass[k]);
       }
     p.remove_if(remove);
     break_parents(time, parents, p, domain, ledger);
@@ -167,7 +167,7 @@ void Grinding::collect_tests(const ParticleStore& p, const ContactEngine& contac
   const double r_min = scene_.breakage.minimum_radius;
   const auto breakable = [&](std::int32_t i) {
     return static_cast<std::size_t>(i) < n_owned && p.material[i] == break_material_ &&
-           p.radius[i] >= r_min;
+           size_radius(p, static_cast<std::size_t>(i)) >= r_min;
   };
   // The pairs: those the evaluation found due (the only ones: a listed pair not in contact has
   // a zero history), in list order.
@@ -226,7 +226,7 @@ void Grinding::run_tests(const std::vector<Test>& tests, std::int64_t step,
     double probability = 0.0, after = before;
     if (vp) {
       // The specific energy of the loading above the level tested and the size's threshold.
-      const double m = p.mass[t.index], d = 2.0 * p.radius[t.index];
+      const double m = p.mass[t.index], d = 2.0 * size_radius(p, t.index);
       const double w = (t.peak - std::max(t.tested, b.xw_min / d * m)) / m;
       if (w <= 0.0) continue;
       probability = vogel_peukert_probability(b.f_mat, 0.0, d, w);
@@ -379,14 +379,14 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
   const SieveSpec& s = scene_.sieve;
   const auto out = [&](std::size_t k) {
     plan_.remove[k] = 1;
-    plan_.product.push_back({time, p.id[k], p.radius[k], p.mass[k]});
+    plan_.product.push_back({time, p.id[k], size_radius(p, k), p.mass[k]});
     plan_.sieved_mass += p.mass[k];
     ++plan_.sieved;
   };
   if (s.type != DischargeType::kOverflow) {
     for (std::size_t k = 0; k < p.n_owned(); ++k)
       if (plan_.remove[k] == 0 && p.material[k] == sieve_material_ &&
-          2.0 * p.radius[k] < s.aperture && in_zone(p.pos[k]))
+          2.0 * size_radius(p, k) < s.aperture && in_zone(p.pos[k]))
         out(k);
     return;
   }
@@ -395,8 +395,8 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     if (p.material[k] != sieve_material_) continue;
     held += SizeMasses::units(p.mass[k]);
-    if (plan_.remove[k] == 0 && 2.0 * p.radius[k] < s.aperture)
-      fine.insert(fine.end(), {std::bit_cast<std::int64_t>(p.radius[k]), p.id[k],
+    if (plan_.remove[k] == 0 && 2.0 * size_radius(p, k) < s.aperture)
+      fine.insert(fine.end(), {std::bit_cast<std::int64_t>(size_radius(p, k)), p.id[k],
                                SizeMasses::units(p.mass[k])});
   }
   held = domain.sum(held);
@@ -506,7 +506,7 @@ SizeMasses Grinding::mill_sizes(const ParticleStore& p, const Domain& domain) co
   SizeMasses m;
   const int ore = ore_material();
   for (std::size_t k = 0; k < p.n_owned(); ++k)
-    if (p.material[k] == ore) m.add(2.0 * p.radius[k], p.mass[k]);
+    if (p.material[k] == ore) m.add(2.0 * size_radius(p, k), p.mass[k]);
   combine(m, domain);
   return m;
 }

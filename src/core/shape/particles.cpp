@@ -146,4 +146,9 @@ std::size_t ParticleStore::add_ghosts(std::size_t n) {
   return first;
 }
 
+double size_radius(const ParticleStore& p, std::size_t k) {
+  if (!p.shaped()) return p.radius[k];
+  return equivalent_radius(SuperEllipse{(*p.semi_a())[k], (*p.semi_b())[k], (*p.exponent())[k]});
+}
+
 }  // namespace dem2d

@@ -202,6 +202,10 @@ class ParticleStore {
   std::unique_ptr<Field<double>> semi_a_, semi_b_, exponent_;
 };
 
+// The radius that sizes particle k (its sieve size is twice it): a disc's radius, a
+// superellipse's volume-equivalent radius (the sphere of its mass; core/shape/superellipse.hpp).
+double size_radius(const ParticleStore& p, std::size_t k);
+
 // 1/2 I w^2 of particle k: the disc's formula in a store without shaped particles (its bits
 // unchanged), else from the stored inverse inertia.
 double rotational_energy(const ParticleStore& p, std::size_t k);
