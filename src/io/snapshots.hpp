@@ -70,6 +70,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/scene.hpp"
@@ -115,6 +116,9 @@ struct SnapshotInfo {
   std::vector<SnapshotDataset> datasets;  // in the group's order: registry fields, speed, extras
   std::uint64_t wall_points = 0;          // M: rows of /walls/NNNNNN/points
   std::uint64_t wall_segments = 0;        // S: rows of /walls/NNNNNN/segments; 0: no outline
+  // K: the points of each particle's outline, /outlines/NNNNNN/points holding N K rows; 0: no
+  // outlines (a scene without shaped particles, or no particles)
+  std::uint64_t outline_vertices = 0;
 };
 
 class SnapshotWriter {
@@ -204,12 +208,18 @@ class SnapshotWriter {
                       const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
   void write_polyvertex(const h5::RowRange& rows);
+  void write_outlines(const std::string& group, const SnapshotInfo& record,
+                      const h5::RowRange& rows, const ParticleStore& p);
+  void write_polygons(std::uint64_t vertices, const h5::RowRange& rows);
   void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
   void agree(const std::string& local_error);                 // IoError on every rank if any failed
   std::vector<SnapshotInfo> drop_and_read(double last_time);  // resume: the file's part
   std::optional<SnapshotInfo> read_record(const std::string& name, double last_time) const;
   void reconcile_polyvertex(const std::vector<SnapshotInfo>& kept);
   void reconcile_walls(std::vector<SnapshotInfo>& kept);
+  void reconcile_outlines(std::vector<SnapshotInfo>& kept);
+  void reconcile_polygons(const std::vector<SnapshotInfo>& kept);
+  void read_outlines(SnapshotInfo& record) const;
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -225,7 +235,8 @@ class SnapshotWriter {
   bool closed_ = false;                       // close() was called
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
-  bool failed_ = false;                       // the last write failed: clear its remains first
+  std::set<std::pair<std::uint64_t, std::uint64_t>> polygon_sizes_;  // (k, n): polygon_k_n
+  bool failed_ = false;  // the last write failed: clear its remains first
   std::optional<std::size_t> fail_before_dataset_;  // fail_before_dataset_for_testing
 };
 
