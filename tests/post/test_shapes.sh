@@ -8,8 +8,8 @@
 # 4ab Gamma(1+1/n)^2 / Gamma(1+2/n) less the polygon's discretisation (an ellipse: exactly
 # (K/2pi) sin(2pi/K) of it; a rounded box: at most 0.2 % less), with the long axis of an
 # ellipse along its angle (the polygon's principal axis of inertia); every disc a circle of its
-# radius; a snapshot without shape datasets (discs only) draws circles only. With DEM2D given
-# and a deck, also on a real run: tests/post/shapes.in (ellipses and rounded squares in a box).
+# radius; a snapshot without shape datasets (discs only) draws circles only. post/h5compare.py
+# compares the outlines of /outlines matched by id.
 #
 #   tests/post/test_shapes.sh [DEM2D [SOURCE_DIR]]
 #
@@ -238,6 +238,46 @@ with h5py.File(sys.argv[2], "r") as f:
 json.dump(pictures, open(sys.argv[3], "w"))
 EOF
 check "report.py's charge picture measured" "$py" "$work/measure.py" "$work/mixed.h5" "$work/drawn_report.json"
+
+# post/h5compare.py compares the particles' outlines (/outlines/NAME/points) matched by id: the
+# made-up scene with outlines, again with its rows in another order (equal), and with one
+# outline point moved by an ulp (a difference naming the outline).
+check "h5compare.py matches outlines by id and finds a changed point" \
+  "$py" - "$post" "$work" <<'EOF'
+import subprocess, sys
+import h5py
+import numpy as np
+post, work = sys.argv[1], sys.argv[2]
+sys.path.insert(0, post)
+import millplot
+def write(path, order, nudge=False):
+    with h5py.File(f"{work}/mixed.h5", "r") as src, h5py.File(path, "w") as f:
+        f["materials/name"] = src["materials/name"][()]
+        for name in ("000000", "000001"):
+            g, s = f.create_group(f"snapshots/{name}"), src["snapshots"][name]
+            for key, value in s.attrs.items():
+                g.attrs[key] = value
+            for field in s:
+                g[field] = s[field][()][order]
+            snap = millplot.read_snapshot(src, name)
+            sh = snap["shape"]
+            pts = millplot.superellipse_outlines(sh["a"], sh["b"], sh["n"], sh["angle"],
+                                                 snap["position"], 24).astype(np.float32)[order]
+            if nudge and name == "000001":
+                pts[5, 3, 1] = np.nextafter(pts[5, 3, 1], np.float32(1))
+            f[f"outlines/{name}/points"] = pts.reshape(-1, 2)
+order = np.arange(36)
+write(f"{work}/a.h5", order)
+write(f"{work}/b.h5", order[::-1].copy())
+write(f"{work}/c.h5", order[::-1].copy(), nudge=True)
+same = subprocess.run([sys.executable, f"{post}/h5compare.py", f"{work}/a.h5", f"{work}/b.h5"],
+                      capture_output=True, text=True)
+assert same.returncode == 0, same.stdout + same.stderr
+differ = subprocess.run([sys.executable, f"{post}/h5compare.py", f"{work}/a.h5", f"{work}/c.h5"],
+                        capture_output=True, text=True)
+assert differ.returncode == 1 and "/snapshots/000001/outline" in differ.stdout, differ.stdout
+print(same.stdout, differ.stdout)
+EOF
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
