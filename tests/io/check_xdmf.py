@@ -229,9 +229,11 @@ class Checker:
 def check_paraview(xmf, h5, snapshots, problems):
     """Opens `xmf` with ParaView's three XDMF readers; each must show, at every time step, the
     particles (a point per particle), their outlines (a polygon cell per particle, its points,
-    speed as cell data) and the wall outline (a cell per segment)."""
+    speed as cell data, each cell of the area of its polygon in the file) and the wall outline
+    (a cell per segment)."""
     from paraview import servermanager
     from paraview import simple
+    from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter
 
     readers = {"XDMF Reader": lambda: simple.XDMFReader(FileNames=[xmf]),
                "Xdmf3 Reader S": lambda: simple.Xdmf3ReaderS(FileName=[xmf]),
@@ -256,6 +258,18 @@ def check_paraview(xmf, h5, snapshots, problems):
                 ds = it.GetCurrentDataObject()
                 speed = ds.GetPointData().GetArray("speed") is not None or ds.GetCellData().GetArray("speed") is not None
                 blocks.append((ds.GetNumberOfPoints(), ds.GetNumberOfCells(), speed))
+                if "outlines" in h5 and name in h5["outlines"] and ds.GetNumberOfCells() and ds.GetCellType(0) == 7:
+                    sizes = vtkCellSizeFilter()  # the polygons as ParaView sees them
+                    sizes.SetInputData(ds)
+                    sizes.SetComputeArea(True)
+                    sizes.Update()
+                    area = sizes.GetOutput().GetCellData().GetArray("Area")
+                    seen = np.array([area.GetValue(i) for i in range(area.GetNumberOfTuples())])
+                    pts = h5["outlines"][name]["points"][()].astype(float).reshape(len(seen), -1, 2)
+                    x, y = pts[..., 0], pts[..., 1]
+                    want_area = 0.5 * np.abs((x * np.roll(y, -1, 1) - np.roll(x, -1, 1) * y).sum(1))
+                    if not np.allclose(seen, want_area, rtol=1e-9, atol=0):
+                        problems.append(f"{label}: snapshot {name}: ParaView's polygon areas differ from the file's")
                 it.GoToNextItem()
             n = h5["snapshots"][name]["id"].shape[0]
             want = [(n, n, True)]
