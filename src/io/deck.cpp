@@ -141,6 +141,7 @@ class DeckParser {
     if (const auto* t = root.table("sieve")) read_sieve(*t);
     if (const auto* t = root.table("output")) read_output(*t);
     check_ore(root_);
+    check_shapes(root_);
 
     if (materials.empty() &&
         (drum != nullptr || !fills.empty() || !particles.empty() || !walls.empty())) {
@@ -460,9 +461,38 @@ class DeckParser {
   void read_particle(const toml::table& table, std::size_t index) {
     const TableReader r(diag_, table, deck::kParticle, index);
     ParticleSpec p;
-    read_keys(r, deck::kParticle, p);
+    const Accepted accepted = read_keys(r, deck::kParticle, p);
     p.source_line = r.line();
+    read_particle_shape(r, accepted, p);
     scene_.particles.push_back(std::move(p));
+  }
+
+  // A disc takes radius; a superellipse semi_axes = [a, b] (and exponent, angle) instead.
+  static void read_particle_shape(const TableReader& r, const Accepted& accepted, ParticleSpec& p) {
+    if (r.has("shape") && !accepted.has("shape")) return;  // reported
+    if (p.shape == ParticleShape::kDisc) {
+      reject_shape_keys(r, {"semi_axes", "exponent", "angle"});
+      require(r, deck::kParticle, "radius");
+      return;
+    }
+    if (r.has("radius"))
+      r.invalid("radius",
+                "not used by shape = \"superellipse\" (semi_axes = [a, b] give its size)");
+    require(r, deck::kParticle, "semi_axes");
+    if (const auto ab = accepted.get<Vec2>("semi_axes");
+        ab && !(ab->x >= deck::kMinRadius && ab->y >= deck::kMinRadius)) {
+      r.invalid("semi_axes", fmt::format("each semi-axis must be >= {:g} m", deck::kMinRadius));
+      p.semi_a = p.semi_b = 0.0;
+    }
+  }
+
+  // Keys a disc does not take.
+  static void reject_shape_keys(const TableReader& r,
+                                std::initializer_list<std::string_view> keys) {
+    for (const std::string_view key : keys)
+      if (r.has(key))
+        r.invalid(key,
+                  "used only by shape = \"superellipse\" (the shape is \"disc\", the default)");
   }
 
   void read_fill(const toml::table& table, std::size_t index) {
@@ -483,10 +513,12 @@ class DeckParser {
                             "file (found {})",
                             r.path(), and_list(sources)));
     }
+    if (fill.shape == ParticleShape::kDisc) reject_shape_keys(r, {"aspect", "exponent"});
     if (sources.size() == 1 && sources[0] == "file") {
       for (const std::string_view key :
            {"radius", "radius_min", "radius_max", "size_distribution", "d50", "sigma",
-            "geometric_sd", "sizes", "mass_fractions", "region", "box_min", "box_max", "mix"}) {
+            "geometric_sd", "sizes", "mass_fractions", "region", "box_min", "box_max", "mix",
+            "shape", "aspect", "exponent"}) {
         if (r.has(key))
           r.invalid(key, "not used by a fill from a file (the file gives each particle)");
       }
@@ -832,6 +864,33 @@ class DeckParser {
   //   - a particle that cannot break must be able to leave: 2 minimum_radius >= the aperture
   //     (else the ore between them neither breaks nor leaves);
   //   - a feed point inside the discharge zone is refused (it would leave at once).
+  // Superellipses run with the Hertz-Mindlin law and the Verlet integrator only.
+  void check_shapes(const toml::table& root) {
+    if (!diag_.messages().empty() || !has_shaped_particles(scene_)) return;
+    std::string shape_key;
+    for (std::size_t i = 0; i < scene_.particles.size() && shape_key.empty(); ++i)
+      if (scene_.particles[i].shaped()) shape_key = fmt::format("particle[{}].shape", i);
+    for (std::size_t i = 0; i < scene_.fills.size() && shape_key.empty(); ++i)
+      if (scene_.fills[i].shape == ParticleShape::kSuperellipse)
+        shape_key = fmt::format("fill[{}].shape", scene_.fills[i].index);
+    const toml::node* shape = root.at_path(shape_key).node();
+    const std::string at = shape != nullptr ? diag_.where(*shape) : shape_key;
+    const auto refuse = [&](const char* path, std::string_view value, std::string_view allowed) {
+      const toml::node* node = root.at_path(path).node();
+      diag_.error_in(node != nullptr ? diag_.where(*node) : std::string(diag_.where(root)),
+                     fmt::format("{} = \"{}\"{}: superellipses ({} = \"superellipse\", {}) run "
+                                 "with {} only",
+                                 path, value, node != nullptr ? "" : " (the default)", shape_key,
+                                 at, allowed));
+    };
+    if (scene_.contact.model != ContactModelKind::kHertzMindlin)
+      refuse("contact.model", deck::choice_name(deck::kContactModels, scene_.contact.model),
+             "contact.model = \"hertz-mindlin\"");
+    if (scene_.run.integrator != IntegratorKind::kVerlet)
+      refuse("run.integrator", deck::choice_name(deck::kIntegrators, scene_.run.integrator),
+             "run.integrator = \"verlet\"");
+  }
+
   void check_ore(const toml::table& root) {
     const BreakageSpec& b = scene_.breakage;
     const SieveSpec& s = scene_.sieve;

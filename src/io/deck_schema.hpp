@@ -82,6 +82,11 @@ inline constexpr std::array kSizeDistributions = {
     Choice<SizeDistribution>{"table", SizeDistribution::kTable},
 };
 
+inline constexpr std::array kParticleShapes = {
+    Choice<ParticleShape>{"disc", ParticleShape::kDisc},
+    Choice<ParticleShape>{"superellipse", ParticleShape::kSuperellipse},
+};
+
 inline constexpr std::array kBreakageModels = {
     Choice<BreakageModel>{"thesis", BreakageModel::kThesis},
     Choice<BreakageModel>{"vogel-peukert", BreakageModel::kVogelPeukert},
@@ -175,6 +180,7 @@ inline constexpr Bound kAtLeastTwo{2.0, Bound{}.hi, false, false};  // >= 2 (int
 inline constexpr Bound kPercent{0.0, 100.0, true, false};           // (0, 100]
 inline constexpr Bound kSizeRatio{1.1, 1e3, false, false};          // [1.1, 1000]
 inline constexpr Bound kSizeEdge{1e-9, 10.0, false, true};          // [1 nm, 10 m)
+inline constexpr Bound kExponent{2.0, 50.0, false, false};          // a superellipse's n
 // A particle's radius, at least 1 nm: far below any particle a mill holds, and far above where
 // its mass rho 4/3 pi r^3 and moment of inertia 2/5 m r^2 leave the normal doubles (for steel
 // the inertia below about 5e-63 m, the mass below 1e-104 m: radius = 1e-120 has mass 0).
@@ -806,6 +812,26 @@ inline constexpr Key<FillSpec> kFillKeys[] = {
      .unit = "m/s",
      .field = member<&FillSpec::velocity>(),
      .doc = "initial velocity of every particle of the fill"},
+    {.name = "shape",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kParticleShapes>,
+     .field = choice<&FillSpec::shape, kParticleShapes>(),
+     .written_if = [](const FillSpec& f) { return f.shape != ParticleShape::kDisc; },
+     .doc = "the particles' shape: `\"disc\"` (a sphere moving in the plane) or "
+            "`\"superellipse\"` (\\|x/a\\|ⁿ + \\|y/b\\|ⁿ = 1, each turned by a random angle); "
+            "a superellipse's radius (from the size keys) is its volume-equivalent radius"},
+    {.name = "aspect",
+     .range = kUnitFraction,
+     .field = member<&FillSpec::aspect>(),
+     .written_if = [](const FillSpec& f) { return f.shape == ParticleShape::kSuperellipse; },
+     .allowed = "(0, 1], with `\"superellipse\"`",
+     .doc = "`\"superellipse\"`: b / a, the short semi-axis over the long one"},
+    {.name = "exponent",
+     .range = kExponent,
+     .field = member<&FillSpec::exponent>(),
+     .written_if = [](const FillSpec& f) { return f.shape == ParticleShape::kSuperellipse; },
+     .allowed = "[2, 50], with `\"superellipse\"`",
+     .doc = "`\"superellipse\"`: n; 2 an ellipse, larger a rounded box"},
     {.name = "mix",
      .type = Type::kBool,
      .field = member<&FillSpec::mix>(),
@@ -819,11 +845,44 @@ inline constexpr Key<ParticleSpec> kParticleKeys[] = {
      .type = Type::kMaterial,
      .need = Need::kRequired,
      .field = member<&ParticleSpec::material>()},
+    {.name = "shape",
+     .type = Type::kChoice,
+     .choices = kChoiceNames<kParticleShapes>,
+     .field = choice<&ParticleSpec::shape, kParticleShapes>(),
+     .written_if = [](const ParticleSpec& p) { return p.shaped(); },
+     .doc = "`\"disc\"` (a sphere moving in the plane) or `\"superellipse\"` "
+            "(\\|x/a\\|ⁿ + \\|y/b\\|ⁿ = 1 in the body's frame)"},
     {.name = "radius",
-     .need = Need::kRequired,
      .unit = "m",
      .range = kRadius,
-     .field = member<&ParticleSpec::radius>()},
+     .field = member<&ParticleSpec::radius>(),
+     .written_if = [](const ParticleSpec& p) { return !p.shaped(); },
+     .default_text = "**required** for a disc"},
+    {.name = "semi_axes",
+     .type = Type::kVector,
+     .unit = "m",
+     .field = {[](ParticleSpec& p, const Value& v) {
+                 p.semi_a = std::get<Vec2>(v).x;
+                 p.semi_b = std::get<Vec2>(v).y;
+               },
+               [](const ParticleSpec& p) -> std::optional<Value> {
+                 return Vec2{p.semi_a, p.semi_b};
+               }},
+     .written_if = [](const ParticleSpec& p) { return p.shaped(); },
+     .default_text = "**required** with `\"superellipse\"`",
+     .allowed = "[a, b], each ≥ 1e-09",
+     .doc = "the semi-axes a (along the body's x) and b"},
+    {.name = "exponent",
+     .range = kExponent,
+     .field = member<&ParticleSpec::exponent>(),
+     .written_if = [](const ParticleSpec& p) { return p.shaped(); },
+     .allowed = "[2, 50], with `\"superellipse\"`",
+     .doc = "n; 2 an ellipse, larger a rounded box"},
+    {.name = "angle",
+     .unit = "**degrees**",
+     .field = degrees<&ParticleSpec::angle>(),
+     .written_if = [](const ParticleSpec& p) { return p.shaped(); },
+     .doc = "`\"superellipse\"`: the body's x axis from the lab's x, counter-clockwise"},
     {.name = "position",
      .type = Type::kVector,
      .need = Need::kRequired,

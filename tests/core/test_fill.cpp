@@ -10,6 +10,7 @@
 #include "core/run/simulation.hpp"
 #include "core/setup/fill.hpp"
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {
@@ -73,6 +74,64 @@ TEST(Fill, CountMonodisperseBottomIsLowestAndNonOverlapping) {
   // 200 spheres of cross-section 2.83e-3 m^2 cover 0.57 m^2 of the lattice: the lower part of
   // a 3.14 m^2 drum, well below the centre.
   EXPECT_LT(y_max, -0.2);
+}
+
+// A fill of superellipses: each has the mass and form the deck asks for (the sphere of its
+// volume-equivalent radius), a random angle, and no two overlap, nor any the shell or a bar.
+TEST(Fill, SuperellipsesHaveTheirEquivalentSpheresMassAndDoNotOverlap) {
+  Scene s = drum_scene();
+  s.drum.lifters.push_back(
+      {.count = 8, .height = 0.08, .width = 0.06, .angle = 0.0, .material = ""});
+  FillSpec f = fill(150, 0.02, 0.04, FillRegion::kBottom);
+  f.shape = ParticleShape::kSuperellipse;
+  f.aspect = 0.4;
+  f.exponent = 6.0;
+  s.fills.push_back(f);
+  FillSpec e = fill(60, 0.03, 0.03, FillRegion::kBottom);
+  e.shape = ParticleShape::kSuperellipse;
+  e.aspect = 0.7;
+  e.mix = true;
+  s.fills.push_back(e);
+  Walls walls(s);
+  ParticleStore p;
+  p.enable_shape();
+  place_particles(s, walls, p);
+  ASSERT_EQ(p.size(), 210u);
+  double c2 = 0.0, s2 = 0.0;
+  int fill0 = 0;
+  for (std::size_t k = 0; k < p.size(); ++k) {
+    const SuperEllipse sk{(*p.semi_a())[k], (*p.semi_b())[k], (*p.exponent())[k]};
+    const bool first = sk.n == 6.0;
+    fill0 += first;
+    EXPECT_NEAR(sk.b / sk.a, first ? 0.4 : 0.7, 1e-15);
+    EXPECT_EQ(sk.n, first ? 6.0 : 2.0);
+    // The mass of the sphere of its volume-equivalent radius, in the fill's range.
+    const double r = std::cbrt(p.mass[k] / (7800 * 4.0 / 3.0 * std::numbers::pi));
+    EXPECT_NEAR(equivalent_radius(sk), r, 1e-14);
+    EXPECT_GE(r, (first ? 0.02 : 0.03) - 1e-14);
+    EXPECT_LE(r, (first ? 0.04 : 0.03) + 1e-14);
+    EXPECT_NEAR(p.radius[k], bounding_radius(sk), 1e-15);
+    EXPECT_NEAR(1.0 / p.inv_inertia[k], inertia_z(sk, 7800), 1e-12 / p.inv_inertia[k]);
+    c2 += std::cos(2.0 * p.theta[k]) / p.size();
+    s2 += std::sin(2.0 * p.theta[k]) / p.size();
+    for (std::size_t j = 0; j < k; ++j) {
+      const SuperEllipse sj{(*p.semi_a())[j], (*p.semi_b())[j], (*p.exponent())[j]};
+      const SuperPairContact c =
+          contact_pair(sk, {p.pos[k], p.theta[k]}, sj, {p.pos[j], p.theta[j]});
+      ASSERT_LT(c.delta, 0.0) << "ids " << j << ", " << k;
+    }
+    for (int w = 0; w < static_cast<int>(walls.elements().size()); ++w) {
+      const WallElement& el = walls.elements()[w];
+      const SuperWallContact c =
+          el.kind == WallKind::kCircle
+              ? contact_inside_circle(sk, p.pos[k], p.theta[k], walls.circle_center(el), el.radius)
+              : contact_segment(sk, p.pos[k], p.theta[k], el.a, el.b);
+      ASSERT_LT(c.contact.g.delta, 0.0) << "id " << k << " wall " << w;
+    }
+  }
+  EXPECT_EQ(fill0, 150);
+  // Random angles: the mean of the doubled angle's unit vector is O(1 / sqrt(210)).
+  EXPECT_LT(std::hypot(c2, s2), 0.2);
 }
 
 TEST(Fill, FillFractionPolydisperseFullRegion) {

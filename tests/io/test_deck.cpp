@@ -602,9 +602,11 @@ colour = "red"
   EXPECT_TRUE(has_message(messages,
                           "deck.in:15:1: error: unknown key 'veloctiy' in "
                           "[[particle]]; did you mean 'velocity'?"));
-  EXPECT_TRUE(has_message(messages,
-                          "deck.in:16:1: error: unknown key 'colour' in [[particle]]; "
-                          "valid keys: material, radius, position, velocity, spin"));
+  EXPECT_TRUE(
+      has_message(messages,
+                  "deck.in:16:1: error: unknown key 'colour' in [[particle]]; "
+                  "valid keys: material, shape, radius, semi_axes, exponent, angle, position, "
+                  "velocity, spin"));
   EXPECT_EQ(messages.size(), 4u);
 }
 
@@ -885,6 +887,118 @@ std::string drum_fill_deck(const std::string& fill_keys) {
          "\n[drum]\nradius = 1.0\nmaterial = \"steel\"\n\n[[fill]]\nmaterial = "
          "\"steel\"\n" +
          fill_keys;
+}
+
+TEST(Deck, ShapesAreRead) {
+  const Scene s = parse_deck_string(kMinimalDeck + R"(
+[[particle]]
+material = "steel"
+shape = "superellipse"
+semi_axes = [0.1, 0.05]
+exponent = 8
+angle = 30
+position = [0.5, 0.5]
+
+[drum]
+radius = 2.0
+material = "steel"
+
+[[fill]]
+material = "steel"
+count = 10
+radius = 0.05
+shape = "superellipse"
+aspect = 0.5
+exponent = 4
+)",
+                                    "shapes.in");
+  ASSERT_EQ(s.particles.size(), 2u);
+  EXPECT_FALSE(s.particles[0].shaped());
+  const ParticleSpec& p = s.particles[1];
+  EXPECT_TRUE(p.shaped());
+  EXPECT_EQ(p.semi_a, 0.1);
+  EXPECT_EQ(p.semi_b, 0.05);
+  EXPECT_EQ(p.exponent, 8.0);
+  EXPECT_EQ(p.angle, 30.0 * kRadiansPerDegree);
+  ASSERT_EQ(s.fills.size(), 1u);
+  EXPECT_EQ(s.fills[0].shape, ParticleShape::kSuperellipse);
+  EXPECT_EQ(s.fills[0].aspect, 0.5);
+  EXPECT_EQ(s.fills[0].exponent, 4.0);
+  EXPECT_TRUE(has_shaped_particles(s));
+  EXPECT_FALSE(has_shaped_particles(parse_deck_string(kMinimalDeck, "discs.in")));
+}
+
+TEST(DeckErrors, ShapeKeys) {
+  const auto messages = deck_errors(kMinimalDeck + R"(
+[[particle]]
+material = "steel"
+shape = "superellipse"
+radius = 0.1
+semi_axes = [0.1, -0.05]
+position = [0.5, 0.5]
+
+[[particle]]
+material = "steel"
+radius = 0.1
+exponent = 4
+angle = 10
+position = [-0.5, 0.5]
+
+[[particle]]
+material = "steel"
+shape = "superellipse"
+exponent = 1.5
+position = [0.5, -0.5]
+
+[[particle]]
+material = "steel"
+shape = "ellipse"
+radius = 0.1
+position = [-0.5, -0.5]
+
+[drum]
+radius = 2.0
+material = "steel"
+
+[[fill]]
+material = "steel"
+count = 5
+radius = 0.05
+aspect = 0.5
+
+[[fill]]
+material = "steel"
+count = 5
+radius = 0.05
+shape = "superellipse"
+aspect = 1.5
+)");
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:15:10: error: particle[1].radius = 0.1: not used by shape = "
+                          "\"superellipse\" (semi_axes = [a, b] give its size)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:16:13: error: particle[1].semi_axes = [0.1, -0.05]: "
+                          "each semi-axis must be >= 1e-09 m"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:22:12: error: particle[2].exponent = 4: used only by shape = "
+                          "\"superellipse\" (the shape is \"disc\", the default)"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:23:9: error: particle[2].angle = 10: used only by shape = "
+                          "\"superellipse\" (the shape is \"disc\", the default)"));
+  EXPECT_TRUE(has_message(
+      messages,
+      "deck.in:26:1: error: particle[3].semi_axes is required (an array of two numbers [x, y])"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:29:12: error: particle[3].exponent = 1.5: must be in [2, 50]"));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:34:9: error: particle[4].shape = \"ellipse\": must be one of "
+                          "\"disc\", \"superellipse\""));
+  EXPECT_TRUE(has_message(messages,
+                          "deck.in:46:10: error: fill[0].aspect = 0.5: used only by shape = "
+                          "\"superellipse\" (the shape is \"disc\", the default)"));
+  EXPECT_EQ(messages.size(), 9u);
+  EXPECT_TRUE(
+      has_message(messages, "deck.in:53:10: error: fill[1].aspect = 1.5: must be in (0, 1]"));
 }
 
 TEST(DeckErrors, FillBedFilling) {
@@ -1424,6 +1538,15 @@ TEST(DeckResolved, ReadsBackFillSizesBedFillingAndMix) {
                           "mix = true\n\n[[fill]]\nmaterial = \"steel\"\ncount = 20\n"
                           "size_distribution = \"normal\"\nd50 = 0.03\nsigma = 0.005\n"
                           "radius_min = 0.01\nradius_max = 0.02\n"));
+}
+
+TEST(DeckResolved, ReadsBackShapes) {
+  const TempDir dir;
+  expect_round_trip(dir, drum_fill_deck("count = 10\nradius = 0.05\nshape = \"superellipse\"\n"
+                                        "aspect = 0.6\nexponent = 3.5\n\n[[particle]]\n"
+                                        "material = \"steel\"\nshape = \"superellipse\"\n"
+                                        "semi_axes = [0.1, 0.04]\nangle = 12.5\n"
+                                        "position = [0.2, -0.3]\n"));
 }
 
 TEST(DeckResolved, WritesEveryDefault) {

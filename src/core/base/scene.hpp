@@ -111,6 +111,10 @@ struct DrumSpec {
 
 enum class FillRegion { kBottom, kFull, kBox, kAnnulus };
 
+// A particle's shape: the disc (a sphere moving in the plane) or the superellipse
+// |x/a|^n + |y/b|^n = 1 (core/shape/superellipse.hpp).
+enum class ParticleShape { kDisc, kSuperellipse };
+
 // A placed fill's law of sizes (core/setup/size_law.hpp).
 enum class SizeDistribution { kUniform, kNormal, kLognormal, kTable };
 
@@ -134,8 +138,13 @@ struct FillSpec {
   Vec2 box_min{0.0, 0.0};  // region = "box"
   Vec2 box_max{0.0, 0.0};
   Vec2 velocity{0.0, 0.0};  // initial velocity of every filled particle
-  int source_line = 0;      // deck line, for error messages
-  int index = 0;            // its element of the deck's [[fill]] array: "fill[2]" in messages
+  // Superellipses: the size law gives each particle's volume-equivalent radius r (the sphere of
+  // its mass), `aspect` = b / a and `exponent` its form; each is turned by a random angle.
+  ParticleShape shape = ParticleShape::kDisc;
+  double aspect = 1.0;    // b / a, in (0, 1]
+  double exponent = 2.0;  // n, in [2, kMaxExponent]
+  int source_line = 0;    // deck line, for error messages
+  int index = 0;          // its element of the deck's [[fill]] array: "fill[2]" in messages
 };
 
 struct ParticleSpec {
@@ -147,7 +156,8 @@ struct ParticleSpec {
   int source_line = 0;
   // A shaped particle (core/shape/superellipse.hpp), when semi_a > 0: |x/a|^n + |y/b|^n = 1 in
   // its body frame, turned by `angle` (rad, counter-clockwise); `radius` is then ignored (the
-  // store's radius is the bounding circle). Not a deck key yet: set by tests and benchmarks.
+  // store's radius is the bounding circle). The deck's shape = "superellipse" sets it.
+  ParticleShape shape = ParticleShape::kDisc;  // the deck's word; semi_a > 0 is what counts
   double semi_a = 0.0;
   double semi_b = 0.0;
   double exponent = 2.0;
@@ -284,6 +294,8 @@ inline bool is_ore_scene(const Scene& s) {
 inline bool has_shaped_particles(const Scene& s) {
   for (const ParticleSpec& p : s.particles)
     if (p.shaped()) return true;
+  for (const FillSpec& f : s.fills)
+    if (f.shape == ParticleShape::kSuperellipse) return true;
   return false;
 }
 

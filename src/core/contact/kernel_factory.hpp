@@ -55,16 +55,24 @@ std::unique_ptr<ContactKernel> make_law_kernel(const ContactSpec& spec, const Pa
 
 namespace dem2d::kernels {
 
-// The superellipse's kernels (core/shape/superellipse_shape.hpp): one law's rolling models with
-// the as-seen stepper and no tracker. Each is a scalar narrow phase of its own, so only the
-// Hertz-Mindlin law is instantiated (kernels_superellipse.cpp); the trackers and the iterative
-// integrator are refused (make_superellipse_kernel).
+// The superellipse's kernels (core/shape/superellipse_shape.hpp): one law's rolling models and
+// trackers with the as-seen stepper. Each is a scalar narrow phase of its own, so only the
+// Hertz-Mindlin law is instantiated (kernels_superellipse.cpp); the iterative integrator is
+// refused (make_contact_kernel).
 template <class Law>
 std::unique_ptr<ContactKernel> make_superellipse_law_kernel(const ContactSpec& spec,
                                                             const PairTable& table,
                                                             RollingModelKind rolling_kind) {
   return pick<RollingModels>(rolling_kind, [&](auto rolling) -> std::unique_ptr<ContactKernel> {
     using Rolling = typename decltype(rolling)::type;
+    if (spec.track_breakage)
+      return std::make_unique<
+          Kernel<ContactModel<Law, Rolling, TrackBreakage, StepAsSeen>, SuperEllipseShape>>(spec,
+                                                                                            table);
+    if (spec.track_peak_energy)
+      return std::make_unique<
+          Kernel<ContactModel<Law, Rolling, TrackPeakEnergy, StepAsSeen>, SuperEllipseShape>>(
+          spec, table);
     return std::make_unique<
         Kernel<ContactModel<Law, Rolling, TrackNone, StepAsSeen>, SuperEllipseShape>>(spec, table);
   });

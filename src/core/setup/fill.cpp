@@ -14,6 +14,7 @@
 #include "core/setup/size_law.hpp"
 #include "core/setup/validate.hpp"
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse_sizing.hpp"
 
 namespace dem2d {
 
@@ -164,6 +165,28 @@ Vec2 jitter(const Scene& scene, std::size_t f, std::size_t k, double slack) {
   return (slack * 0.7071) * Vec2{jx, jy};
 }
 
+// The radius of the circle that holds a particle of fill s of (volume-equivalent) radius r.
+double held_radius(const FillSpec& s, double r) {
+  if (s.shape == ParticleShape::kDisc) return r;
+  return r * bounding_factor(s.aspect, s.exponent);
+}
+
+// Particle k of fill f, of (volume-equivalent) radius r, at x: a disc, or a superellipse turned
+// by an angle uniform in [0, 2 pi) keyed by (seed, fill, particle).
+void add_filled(const Scene& scene, ParticleStore& store, std::size_t f, std::size_t k,
+                std::int64_t id, int mat, double r, Vec2 x) {
+  const FillSpec& s = scene.fills[f];
+  const double density = scene.materials[mat].density;
+  if (s.shape == ParticleShape::kDisc) {
+    store.add(id, mat, r, density, x, s.velocity, 0.0);
+    return;
+  }
+  const SuperEllipse e = superellipse_of_size(r, s.aspect, s.exponent);
+  const double angle =
+      2.0 * std::numbers::pi * random_uniform(scene.run.seed, kFillStream + 5000 + f, k);
+  store.add_shaped(id, mat, e.a, e.b, e.n, density, x, s.velocity, 0.0, angle);
+}
+
 std::string do_not_fit(const Scene& scene, std::size_t f, std::size_t n, std::size_t sites,
                        const std::string& mixed) {
   std::ostringstream o;
@@ -179,7 +202,8 @@ void place_fill(const Scene& scene, const Walls& walls, ParticleStore& store, st
                 double r_all_max, std::int64_t& next_id, std::vector<std::string>& errors) {
   const FillSpec& s = scene.fills[f];
   const std::vector<double> r = fill_radii(scene, f);
-  std::vector<Site> sites = fill_sites(scene, walls, store, f, s.radius_max, r_all_max);
+  const double r_place = placement_radius_max(s);
+  std::vector<Site> sites = fill_sites(scene, walls, store, f, r_place, r_all_max);
   if (sites.size() < r.size()) {
     errors.push_back(do_not_fit(scene, f, r.size(), sites.size(), ""));
     return;
@@ -187,11 +211,11 @@ void place_fill(const Scene& scene, const Walls& walls, ParticleStore& store, st
   std::stable_sort(sites.begin(), sites.end(),
                    [](const Site& a, const Site& b) { return a.key < b.key; });
   const int mat = find_material(scene, s.material);
-  const double spacing = 2.1 * s.radius_max;  // as in fill_sites
+  const double spacing = 2.1 * r_place;  // as in fill_sites
   const double half = 0.5 * spacing;
   for (std::size_t k = 0; k < r.size(); ++k) {
-    const Vec2 x = sites[k].x + jitter(scene, f, k, half - r[k]);
-    store.add(next_id++, mat, r[k], scene.materials[mat].density, x, s.velocity, 0.0);
+    const Vec2 x = sites[k].x + jitter(scene, f, k, half - held_radius(s, r[k]));
+    add_filled(scene, store, f, k, next_id++, mat, r[k], x);
   }
 }
 
@@ -209,7 +233,7 @@ void place_mixed(const Scene& scene, const Walls& walls, ParticleStore& store, c
   for (std::size_t i = 0; i < m; ++i) {
     const std::size_t f = g.first + i;
     radii[i] = fill_radii(scene, f);
-    sites[i] = fill_sites(scene, walls, store, f, scene.fills[f].radius_max, r_all_max);
+    sites[i] = fill_sites(scene, walls, store, f, placement_radius_max(scene.fills[f]), r_all_max);
     std::stable_sort(sites[i].begin(), sites[i].end(),
                      [](const Site& a, const Site& b) { return a.key < b.key; });
     owner.insert(owner.end(), radii[i].size(), i);
@@ -223,8 +247,8 @@ void place_mixed(const Scene& scene, const Walls& walls, ParticleStore& store, c
   std::vector<std::size_t> next(m, 0);
   for (const std::size_t i : owner) {
     const std::size_t f = g.first + i, k = at[i].size();
-    const double r = radii[i][k];
-    const Vec2 offset = jitter(scene, f, k, 0.5 * (2.1 * scene.fills[f].radius_max) - r);
+    const double r = held_radius(scene.fills[f], radii[i][k]);
+    const Vec2 offset = jitter(scene, f, k, 0.5 * (2.1 * placement_radius_max(scene.fills[f])) - r);
     while (next[i] < sites[i].size() && placed.overlaps(sites[i][next[i]].x + offset, r, r_all_max))
       ++next[i];
     if (next[i] == sites[i].size()) {
@@ -240,8 +264,7 @@ void place_mixed(const Scene& scene, const Walls& walls, ParticleStore& store, c
     const FillSpec& s = scene.fills[g.first + i];
     const int mat = find_material(scene, s.material);
     for (std::size_t k = 0; k < at[i].size(); ++k)
-      store.add(next_id++, mat, radii[i][k], scene.materials[mat].density, at[i][k], s.velocity,
-                0.0);
+      add_filled(scene, store, g.first + i, k, next_id++, mat, radii[i][k], at[i][k]);
   }
 }
 
@@ -278,7 +301,7 @@ void place_particles(const Scene& scene, const Walls& walls, ParticleStore& stor
   }
   double r_all_max = 0.0;
   for (std::size_t k = 0; k < store.size(); ++k) r_all_max = std::max(r_all_max, store.radius[k]);
-  for (const FillSpec& s : scene.fills) r_all_max = std::max(r_all_max, s.radius_max);
+  for (const FillSpec& s : scene.fills) r_all_max = std::max(r_all_max, placement_radius_max(s));
   if (r_all_max <= 0.0) return;
 
   for (std::size_t f = 0; f < scene.fills.size();) {

@@ -9,7 +9,9 @@
 // A fill with mix = true is placed together with the fill before it: each keeps its lattice,
 // their particles dealt in a shuffled order, each to its lattice's next site clear of those
 // placed. Radii follow the fill's size_distribution (size_law.hpp); every draw is keyed by
-// (seed, fill, particle), so every rank places the same particles.
+// (seed, fill, particle), so every rank places the same particles. A fill of superellipses
+// places each within its bounding circle (the lattice's r_max is the largest bounding radius),
+// turned by a random angle, so none overlaps either.
 #pragma once
 
 #include "core/base/scene.hpp"

@@ -7,8 +7,14 @@
 
 #include "core/base/random.hpp"
 #include "core/mill/mill_analytics.hpp"  // kBedPacking
+#include "core/shape/superellipse_sizing.hpp"
 
 namespace dem2d {
+
+double placement_radius_max(const FillSpec& s) {
+  if (s.shape == ParticleShape::kDisc) return s.radius_max;
+  return s.radius_max * bounding_factor(s.aspect, s.exponent);
+}
 
 namespace {
 

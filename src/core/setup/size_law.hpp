@@ -27,6 +27,11 @@ inline constexpr int kLawSteps = 4096;
 // (fill_fraction pi R^2, or bed_filling kBedPacking pi R^2); 0 for a fill by count.
 double fill_target_area(const Scene& scene, const FillSpec& s);
 
+// The radius of the circle that holds the fill's largest particle: radius_max for discs, the
+// bounding radius of a superellipse of volume-equivalent radius radius_max (its lattice's
+// spacing is 2.1 times this).
+double placement_radius_max(const FillSpec& s);
+
 // The radii of fill `fill`'s particles in the order of their ids: its count, or as many as
 // reach its target area (the table: the count that mean area gives, see table_counts).
 std::vector<double> fill_radii(const Scene& scene, std::size_t fill);

@@ -56,7 +56,7 @@ double expected_fill_count(const Scene& scene, std::size_t fill) {
 
 double fill_lattice_sites(const Scene& scene, std::size_t fill) {
   const FillSpec& s = scene.fills[fill];
-  const double spacing = 2.1 * s.radius_max;
+  const double spacing = 2.1 * placement_radius_max(s);
   if (!(spacing > 0.0)) return 0.0;
   Vec2 extent = s.box_max - s.box_min;
   double kept = 1.0;  // the share of the bounding box's sites the region keeps
