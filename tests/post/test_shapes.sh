@@ -9,7 +9,8 @@
 # (K/2pi) sin(2pi/K) of it; a rounded box: at most 0.2 % less), with the long axis of an
 # ellipse along its angle (the polygon's principal axis of inertia); every disc a circle of its
 # radius; a snapshot without shape datasets (discs only) draws circles only. post/h5compare.py
-# compares the outlines of /outlines matched by id.
+# compares the outlines of /outlines matched by id. Then a real run of tests/post/shapes.in
+# (ellipses, rounded squares, discs and a fill of superellipses in a box) on 1 and 2 ranks.
 #
 #   tests/post/test_shapes.sh [DEM2D [SOURCE_DIR]]
 #
@@ -278,6 +279,59 @@ differ = subprocess.run([sys.executable, f"{post}/h5compare.py", f"{work}/a.h5",
 assert differ.returncode == 1 and "/snapshots/000001/outline" in differ.stdout, differ.stdout
 print(same.stdout, differ.stdout)
 EOF
+
+# --- A real run: tests/post/shapes.in (ellipses, rounded squares and discs into a box) ----------
+# On 1 and 2 ranks: the two files agree bit for bit (post/h5compare.py, outlines included), both
+# sidecars pass tests/io/check_xdmf.py (the outlines' polygons measured against the shape
+# datasets), the first snapshot holds the deck's shapes and angles, render_snapshot.py's
+# pictures measure as above, and report.py makes its charge pictures.
+deck=$source_dir/tests/post/shapes.in
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+check "dem2d runs tests/post/shapes.in on 1 and 2 ranks" \
+  bash -c "'$dem2d' --quiet --output '$work/run1' '$deck' &&
+           mpirun -np 2 --oversubscribe '$dem2d' --quiet --output '$work/run2' '$deck'"
+check "1 and 2 ranks: the same snapshots, outlines included (h5compare.py)" \
+  "$py" "$post/h5compare.py" "$work/run1/snapshots.h5" "$work/run2/snapshots.h5"
+check "check_xdmf.py on both runs' snapshots.xmf" \
+  bash -c "'$py' '$source_dir/tests/io/check_xdmf.py' '$work/run1/snapshots.xmf' &&
+           '$py' '$source_dir/tests/io/check_xdmf.py' '$work/run2/snapshots.xmf'"
+check "the first snapshot holds the deck's shapes and angles" \
+  "$py" - "$deck" "$work/run1/snapshots.h5" <<'EOF'
+import sys, tomllib
+import h5py
+import numpy as np
+deck = tomllib.load(open(sys.argv[1], "rb"))
+with h5py.File(sys.argv[2], "r") as f:
+    g = f["snapshots/000000"]
+    pos, a, b, n, angle = (g[k][()] for k in ("position", "semi_axis_a", "semi_axis_b", "exponent", "angle"))
+    assert "outlines" in f and len(f["outlines/000000/points"]) == 24 * len(pos)
+bad = []
+fill = deck["fill"][0]
+assert len(pos) == len(deck["particle"]) + fill["count"], len(pos)
+for p in deck["particle"]:
+    k = int(np.argmin(np.hypot(*(pos - np.array(p["position"])).T)))
+    if p.get("shape") == "superellipse":
+        want = (p["semi_axes"][0], p["semi_axes"][1], p.get("exponent", 2.0), np.radians(p["angle"]))
+    else:
+        want = (p["radius"], p["radius"], 2.0, 0.0)
+    got = (a[k], b[k], n[k], angle[k])
+    if got[:3] != want[:3] or abs(got[3] - want[3]) > 1e-12:
+        bad.append(f"particle at {p['position']}: (a, b, n, angle) = {got}, the deck's {want}")
+# The fill's particles: superellipses of b / a = aspect, n = exponent.
+rest = np.ones(len(pos), bool)
+for p in deck["particle"]:
+    rest[int(np.argmin(np.hypot(*(pos - np.array(p["position"])).T)))] = False
+if not (np.allclose(b[rest] / a[rest], fill["aspect"], rtol=1e-12) and np.all(n[rest] == fill["exponent"])):
+    bad.append(f"the fill's particles: b/a {b[rest] / a[rest]}, n {n[rest]}")
+print("\n".join(bad))
+assert not bad
+EOF
+check "render_snapshot.py on the run: outlines at their angles (--json measured)" \
+  bash -c "'$py' '$post/render_snapshot.py' '$work/run1/snapshots.h5' --all -o '$work/run_frames' --json '$work/run.json' &&
+           '$py' '$work/measure.py' '$work/run1/snapshots.h5' '$work/run.json'"
+check "report.py on the run makes its charge pictures" \
+  bash -c "'$py' '$post/report.py' '$work/run1' --no-animation > '$work/report.log' 2>&1 &&
+           ls '$work/run1/report/'charge_*.png > /dev/null"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
