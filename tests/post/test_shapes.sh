@@ -10,7 +10,8 @@
 # ellipse along its angle (the polygon's principal axis of inertia); every disc a circle of its
 # radius; a snapshot without shape datasets (discs only) draws circles only. post/h5compare.py
 # compares the outlines of /outlines matched by id. Then a real run of tests/post/shapes.in
-# (ellipses, rounded squares, discs and a fill of superellipses in a box) on 1 and 2 ranks.
+# (ellipses, rounded squares, discs and a fill of superellipses in a box) on 1 and 2 ranks, and
+# stopped half-way and continued with --restart.
 #
 #   tests/post/test_shapes.sh [DEM2D [SOURCE_DIR]]
 #
@@ -332,6 +333,17 @@ check "render_snapshot.py on the run: outlines at their angles (--json measured)
 check "report.py on the run makes its charge pictures" \
   bash -c "'$py' '$post/report.py' '$work/run1' --no-animation > '$work/report.log' 2>&1 &&
            ls '$work/run1/report/'charge_*.png > /dev/null"
+
+# A run stopped at 0.15 s (its checkpoint) and continued with --restart on 2 ranks: its
+# snapshots.h5 continues the first part's (the snapshots after the checkpoint replaced), the
+# same as the uninterrupted run's snapshot for snapshot, outlines included, and its sidecar
+# lists them all with their outlines.
+check "a run continued with --restart: the same snapshots and outlines as the whole run" \
+  bash -c "'$dem2d' --quiet --output '$work/part' --set run.duration=0.15 '$deck' &&
+           mpirun -np 2 --oversubscribe '$dem2d' --quiet --output '$work/part' --restart '$work/part/checkpoint.h5' '$deck' &&
+           '$py' '$post/h5compare.py' --by-step --allow-added '$work/run1/snapshots.h5' '$work/part/snapshots.h5' &&
+           '$py' '$source_dir/tests/io/check_xdmf.py' '$work/part/snapshots.xmf' &&
+           test \$('$py' -c 'import h5py, sys; f = h5py.File(sys.argv[1]); print(len(f[\"outlines\"]) == len(f[\"snapshots\"]))' '$work/part/snapshots.h5') = True"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
