@@ -8,8 +8,10 @@ Within each snapshot both files' particles are sorted by id, so runs on differen
 (whose files hold the particles in a different order) compare equal when the physics is the
 same. Compared: the number and names of snapshots, their time and step attributes, the set of
 ids, every per-particle dataset (id, material, position, velocity, angle, spin, radius: whatever
-the files hold; a dataset in one file only is a difference) and the /materials table. The
-datasets' unit and doc attributes and /xdmf (ParaView helper data) are not compared.
+the files hold; a dataset in one file only is a difference), the particles' outline polygons
+of scenes with superellipses (/outlines/NAME/points, as "outline", each particle's points
+matched by id) and the /materials table. The datasets' unit and doc attributes and /xdmf
+(ParaView helper data) are not compared.
 With --by-step, snapshots are paired by their step attribute instead of their names: a run
 that was interrupted (which wrote a last snapshot where it stopped) and restarted compares
 with the uninterrupted run, the extra snapshot allowed by --allow-added.
@@ -89,7 +91,15 @@ def compare_arrays(where, field, a, b, ids, atol, report):
                       f" vs {fmt(b[row]) if b.ndim == 1 else b[row].tolist()}")
 
 
-def compare_snapshot(name, ga, gb, atol, report):
+def outline_rows(f, name, count):
+    """The outline points of snapshot `name` as (N, K, 2) rows, or None when it has none."""
+    if "outlines" not in f or name not in f["outlines"]:
+        return None
+    points = f["outlines"][name]["points"][()]
+    return points.reshape(count, -1, 2) if count else points.reshape(0, 0, 2)
+
+
+def compare_snapshot(name, ga, gb, atol, report, outlines=(None, None)):
     where = f"/snapshots/{name}"
     for attr in ("time", "step"):
         va, vb = ga.attrs.get(attr), gb.attrs.get(attr)
@@ -121,6 +131,13 @@ def compare_snapshot(name, ga, gb, atol, report):
                           f"{len(idb)} particles")
             continue
         compare_arrays(where, field, a[ia], b[ib], common, atol, report)
+    oa, ob = outlines
+    if oa is None and ob is not None and report.allow_added:
+        report.added.add("outline")
+    elif (oa is None) != (ob is None):
+        report.differ(f"/outlines/{name}: only in the {'first' if oa is not None else 'second'} file")
+    elif oa is not None:
+        compare_arrays(where, "outline", oa[ia], ob[ib], common, atol, report)
 
 
 def compare_materials(fa, fb, atol, report):
@@ -183,8 +200,9 @@ def main(argv=None):
         compare_materials(fa, fb, args.atol, report)
         common = paired_snapshots(fa, fb, args.by_step, report)
         for name_a, name_b in common:
-            compare_snapshot(name_a, fa["snapshots"][name_a], fb["snapshots"][name_b], args.atol,
-                             report)
+            ga, gb = fa["snapshots"][name_a], fb["snapshots"][name_b]
+            outlines = (outline_rows(fa, name_a, len(ga["id"])), outline_rows(fb, name_b, len(gb["id"])))
+            compare_snapshot(name_a, ga, gb, args.atol, report, outlines)
     if report.differences == 0:
         what = "bit-identical" if args.atol == 0 else f"identical within atol = {args.atol:g}"
         added = f"; datasets only in the second file: {', '.join(sorted(report.added))}" if report.added else ""

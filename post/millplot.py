@@ -13,8 +13,10 @@ What a mill engineer reads off it:
   - moving_average, averaged_power: the drive power averaged in time (raw 1 ms samples spike);
   - regime_spans, dominant_regime: the charge's regime column in time.
 Drawing:
-  - draw_charge(ax, ...)     the particles at their true radius coloured by speed, with the drum
-                             and lifter outline (from the snapshot file, else from the deck).
+  - draw_charge(ax, ...)     the particles at their true size coloured by speed, with the drum
+                             and lifter outline (from the snapshot file, else from the deck);
+  - particle_collections     discs as circles, superellipses as their outline polygons at their
+                             angles (superellipse_outlines), for any colouring.
 """
 
 import csv
@@ -23,7 +25,7 @@ import math
 import os
 
 import numpy as np
-from matplotlib.collections import EllipseCollection, LineCollection
+from matplotlib.collections import EllipseCollection, LineCollection, PolyCollection
 
 from snapshot_order import snapshot_names
 
@@ -126,8 +128,20 @@ def list_snapshots(f):
     return snapshot_names(f)
 
 
+def read_shape(g):
+    """The shape datasets of a snapshot group (scenes with superellipses) as {a, b, n, angle}
+    arrays [m, m, 1, rad], or None for a snapshot without them (discs only)."""
+    if "semi_axis_a" not in g:
+        return None
+    return {"a": np.asarray(g["semi_axis_a"][()], dtype=float),
+            "b": np.asarray(g["semi_axis_b"][()], dtype=float),
+            "n": np.asarray(g["exponent"][()], dtype=float),
+            "angle": np.asarray(g["angle"][()], dtype=float)}
+
+
 def read_snapshot(f, name):
-    """One snapshot: time [s], position (N, 2) [m], radius [m], speed [m/s], material."""
+    """One snapshot: time [s], id, position (N, 2) [m], radius [m], speed [m/s], material, and
+    shape (read_shape: None without superellipses)."""
     g = f["snapshots"][name]
     position = np.asarray(g["position"][()], dtype=float).reshape(-1, 2)
     if "speed" in g:
@@ -138,10 +152,12 @@ def read_snapshot(f, name):
     return {
         "name": name,
         "time": float(g.attrs["time"]),
+        "id": np.asarray(g["id"][()]),
         "position": position,
         "radius": np.asarray(g["radius"][()], dtype=float),
         "speed": speed,
         "material": np.asarray(g["material"][()]),
+        "shape": read_shape(g),
     }
 
 
@@ -462,21 +478,81 @@ def charge_limits(deck, snap, outline):
     return (lo[0] - margin, hi[0] + margin), (lo[1] - margin, hi[1] + margin)
 
 
-def particle_collection(ax, snap, vmax, cmap="viridis"):
-    """The particles as circles of their true radius coloured by speed (an EllipseCollection
-    in data units); added to ax and returned (for a colorbar)."""
-    r = snap["radius"]
+# Points of each superellipse's drawn outline (a multiple of 4): the polygon's area is within
+# 0.2 % of the curve's (an ellipse: (K / 2 pi) sin(2 pi / K) = 0.9984 of it).
+OUTLINE_VERTICES = 64
+
+
+def superellipse_outlines(a, b, n, angle, position, vertices=OUTLINE_VERTICES):
+    """(M, K, 2) outline points [m] of M superellipses |x/a|^n + |y/b|^n = 1 turned by `angle`
+    about their centres `position` (M, 2): the parametric form x = a sgn(cos t)|cos t|^(2/n),
+    y = b sgn(sin t)|sin t|^(2/n) at t = 2 pi k / K, counter-clockwise, as snapshots.h5's
+    /outlines (core/shape/outline.hpp). cos t and sin t at the quarter turns are exact (0, +-1),
+    so the points there lie on the axes for any n."""
+    a, b, n, angle = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (a, b, n, angle))
+    position = np.asarray(position, dtype=float).reshape(-1, 2)
+    quarter = vertices // 4
+    q, r = np.divmod(np.arange(4 * quarter), quarter)
+    phi = 2.0 * np.pi * r / (4 * quarter)
+    c0, s0 = np.where(r == 0, 1.0, np.cos(phi)), np.where(r == 0, 0.0, np.sin(phi))
+    c = np.choose(q, [c0, -s0, -c0, s0])
+    s = np.choose(q, [s0, c0, -s0, -c0])
+    power = (2.0 / n)[:, None]
+    x = a[:, None] * np.sign(c) * np.abs(c) ** power
+    y = b[:, None] * np.sign(s) * np.abs(s) ** power
+    ca, sa = np.cos(angle)[:, None], np.sin(angle)[:, None]
+    return np.stack([position[:, :1] + ca * x - sa * y, position[:, 1:] + sa * x + ca * y], axis=-1)
+
+
+def shaped_rows(snap):
+    """Indices of the snapshot's particles that are not discs (a != b or n != 2)."""
+    shape = snap.get("shape")
+    if shape is None:
+        return np.zeros(0, dtype=np.int64)
+    return np.flatnonzero((shape["a"] != shape["b"]) | (shape["n"] != 2.0))
+
+
+def particle_collections(ax, snap, values=None, cmap="viridis", clim=(0.0, 1.0), facecolors=None,
+                         edgecolors="0.2", linewidths=0.2):
+    """The particles at their true size: discs as circles (an EllipseCollection in data units,
+    first, always there), superellipses as their outline polygons at their angles (a
+    PolyCollection, only when the snapshot has some). Coloured by `values` through cmap and
+    clim, or with `facecolors` (one per particle). Added to ax and returned as a list (the
+    first for a colorbar); each collection's `rows` are the snapshot rows it draws."""
+    shaped = shaped_rows(snap)
+    discs = np.setdiff1d(np.arange(len(snap["radius"])), shaped)
+    r = snap["radius"][discs]
     kwargs = dict(widths=2 * r, heights=2 * r, angles=np.zeros_like(r), units="xy",
-                  offsets=snap["position"], edgecolors="0.2", linewidths=0.2)
+                  offsets=snap["position"][discs].reshape(-1, 2), edgecolors=edgecolors,
+                  linewidths=linewidths)
     try:
         circles = EllipseCollection(offset_transform=ax.transData, **kwargs)
     except TypeError:  # matplotlib < 3.6
         circles = EllipseCollection(transOffset=ax.transData, **kwargs)
-    circles.set_array(snap["speed"])
-    circles.set_cmap(cmap)
-    circles.set_clim(0.0, vmax if vmax > 0 else 1.0)
-    ax.add_collection(circles)
-    return circles
+    circles.rows = discs
+    out = [circles]
+    if shaped.size:
+        shape = snap["shape"]
+        verts = superellipse_outlines(shape["a"][shaped], shape["b"][shaped], shape["n"][shaped],
+                                      shape["angle"][shaped], snap["position"][shaped])
+        polygons = PolyCollection(verts, closed=True, edgecolors=edgecolors, linewidths=linewidths)
+        polygons.rows = shaped
+        out.append(polygons)
+    for c in out:
+        if facecolors is not None:
+            c.set_facecolor([facecolors[i] for i in c.rows])
+        else:
+            c.set_array(np.asarray(values)[c.rows])
+            c.set_cmap(cmap)
+            c.set_clim(*clim)
+        ax.add_collection(c)
+    return out
+
+
+def particle_collection(ax, snap, vmax, cmap="viridis"):
+    """The particles at their true size coloured by speed (particle_collections); added to ax.
+    Returns the list of collections (the first for a colorbar)."""
+    return particle_collections(ax, snap, snap["speed"], cmap, (0.0, vmax if vmax > 0 else 1.0))
 
 
 def draw_charge(ax, snap, outline, deck, vmax):
@@ -484,7 +560,7 @@ def draw_charge(ax, snap, outline, deck, vmax):
     built from the deck at the snapshot's time). Returns the particles' collection."""
     if outline is None:
         outline = deck_outline(deck, snap["time"])
-    circles = particle_collection(ax, snap, vmax)
+    circles = particle_collection(ax, snap, vmax)[0]
     if outline is not None and len(outline):
         ax.add_collection(LineCollection(outline, colors="0.15", linewidths=1.5))
     xlim, ylim = charge_limits(deck, snap, outline)

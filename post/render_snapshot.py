@@ -1,14 +1,19 @@
 #!/usr/bin/python3
-"""Draw the particles of a dem2d snapshots.h5 as circles, coloured by material or speed.
+"""Draw the particles of a dem2d snapshots.h5 at their true size, coloured by material or speed.
 
     post/render_snapshot.py OUT/snapshots.h5                   # last snapshot -> PNG
     post/render_snapshot.py OUT/snapshots.h5 --index 0 --color speed -o first.png
     post/render_snapshot.py OUT/snapshots.h5 --all -o frames/  # every snapshot, one PNG each
     post/render_snapshot.py OUT/snapshots.h5 --list            # what the file holds
+    post/render_snapshot.py OUT/snapshots.h5 --json drawn.json # also: what was drawn
 
 The drum is drawn when its radius is known: from --drum-radius / --drum-center, or else from
 run.json beside the HDF5 file ({"deck": {"drum": {"radius": R, "center": [x, y]}}}).
-Particles are drawn at their true radius (in data units), so a packing looks like a packing.
+Particles are drawn at their true size (in data units), so a packing looks like a packing:
+discs as circles of their radius, superellipses (snapshots with semi_axis_a, semi_axis_b and
+exponent) as their outline polygons (64 points on the curve) turned by their angle. --json
+writes, for the picture drawn, each circle (id, centre, radius) and each outline polygon (id
+and its vertices as drawn), so that a test can measure them.
 """
 
 import argparse
@@ -26,6 +31,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import EllipseCollection  # noqa: E402
 from matplotlib.patches import Circle, Patch  # noqa: E402
 
+import millplot  # noqa: E402
 from snapshot_order import snapshot_names  # noqa: E402
 
 
@@ -41,10 +47,12 @@ def read_snapshot(f, name):
         "name": name,
         "time": float(g.attrs["time"]),
         "step": int(g.attrs["step"]),
+        "id": np.asarray(g["id"][()]),
         "position": np.asarray(g["position"][()]).reshape(-1, 2),
         "velocity": np.asarray(g["velocity"][()]).reshape(-1, 2),
         "radius": np.asarray(g["radius"][()]),
         "material": np.asarray(g["material"][()]),
+        "shape": millplot.read_shape(g),
     }
 
 
@@ -109,7 +117,26 @@ def shell_outlines(radius, center, shell, t):
     return lines
 
 
-def render(snap, materials, drum, color, speed_max, out, size, dpi):
+def drawn_shapes(snap, collections):
+    """What the picture shows of each particle: {"circles": [{id, centre, radius}],
+    "outlines": [{id, vertices}]} (the vertices as the PolyCollection holds them, data units)."""
+    circles, outlines = [], []
+    for c in collections:
+        if isinstance(c, EllipseCollection):  # the discs, drawn at their radius
+            for i, row in enumerate(c.rows):
+                circles.append({"id": int(snap["id"][row]),
+                                "centre": [float(v) for v in snap["position"][row]],
+                                "radius": float(snap["radius"][row])})
+        else:
+            for row, path in zip(c.rows, c.get_paths()):
+                verts = path.vertices
+                if len(verts) > 1 and np.array_equal(verts[0], verts[-1]):
+                    verts = verts[:-1]  # the closing point
+                outlines.append({"id": int(snap["id"][row]), "vertices": verts.tolist()})
+    return {"snapshot": snap["name"], "circles": circles, "outlines": outlines}
+
+
+def render(snap, materials, drum, color, speed_max, out, size, dpi, drawn=None):
     pos, r = snap["position"], snap["radius"]
     fig, ax = plt.subplots(figsize=(size, size), constrained_layout=True)
     ax.set_aspect("equal")
@@ -123,7 +150,7 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi):
         margin = 0.05 * radius
         ax.set_xlim(center[0] - radius - margin, center[0] + radius + margin)
         ax.set_ylim(center[1] - radius - margin, center[1] + radius + margin)
-    elif len(r):
+    elif len(r):  # radius: the bounding circle of a superellipse
         lo = (pos - r[:, None]).min(axis=0)
         hi = (pos + r[:, None]).max(axis=0)
         margin = 0.05 * max(hi[0] - lo[0], hi[1] - lo[1], 2 * float(r.max()))
@@ -131,24 +158,17 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi):
         ax.set_ylim(lo[1] - margin, hi[1] + margin)
 
     if len(r):
-        kwargs = dict(widths=2 * r, heights=2 * r, angles=np.zeros_like(r), units="xy",
-                      offsets=pos, edgecolors="0.15", linewidths=0.3)
-        try:
-            circles = EllipseCollection(offset_transform=ax.transData, **kwargs)
-        except TypeError:  # matplotlib < 3.6
-            circles = EllipseCollection(transOffset=ax.transData, **kwargs)
+        style = dict(edgecolors="0.15", linewidths=0.3)
         if color == "speed":
             speed = np.hypot(snap["velocity"][:, 0], snap["velocity"][:, 1])
-            circles.set_array(speed)
-            circles.set_cmap("viridis")
-            circles.set_clim(0.0, speed_max if speed_max > 0 else 1.0)
-            ax.add_collection(circles)
-            fig.colorbar(circles, ax=ax, shrink=0.8, label="speed [m/s]")
+            drawn_collections = millplot.particle_collections(
+                ax, snap, speed, "viridis", (0.0, speed_max if speed_max > 0 else 1.0), **style)
+            fig.colorbar(drawn_collections[0], ax=ax, shrink=0.8, label="speed [m/s]")
         else:
             cmap = plt.get_cmap("tab10")
             mat = snap["material"].astype(int)
-            circles.set_facecolor([cmap(m % 10) for m in mat])
-            ax.add_collection(circles)
+            drawn_collections = millplot.particle_collections(
+                ax, snap, facecolors=[cmap(m % 10) for m in mat], **style)
             used = sorted(set(mat.tolist()))
             labels = [materials[m] if 0 <= m < len(materials) else f"material {m}" for m in used]
             ax.legend(handles=[Patch(color=cmap(m % 10), label=lab) for m, lab in zip(used, labels)],
@@ -159,6 +179,15 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi):
     ax.set_ylabel("y [m]")
     fig.savefig(out, dpi=dpi)
     plt.close(fig)
+    if drawn is not None:
+        drawn.append(drawn_shapes(snap, drawn_collections if len(r) else []))
+
+
+def write_drawn(path, drawn):
+    """--json: the list of drawn_shapes, one per picture."""
+    if path:
+        with open(path, "w", encoding="utf-8") as fh:
+            json.dump(drawn, fh)
 
 
 def main(argv=None):
@@ -180,7 +209,11 @@ def main(argv=None):
                         "with --all, a directory for frame_NNNNNN.png (default: frames/ beside it)")
     parser.add_argument("--size", type=float, default=7.0, help="figure size [inch]")
     parser.add_argument("--dpi", type=int, default=120)
+    parser.add_argument("--json", metavar="FILE",
+                        help="also write what was drawn: per picture, each circle (id, centre, "
+                        "radius) and each superellipse outline (id, vertices)")
     args = parser.parse_args(argv)
+    drawn = [] if args.json else None
 
     try:
         f = h5py.File(args.snapshots, "r")
@@ -213,8 +246,9 @@ def main(argv=None):
             for name in names:
                 out = os.path.join(outdir, f"frame_{name}.png")
                 render(read_snapshot(f, name), materials, drum, args.color, speed_max, out,
-                       args.size, args.dpi)
+                       args.size, args.dpi, drawn)
             print(f"{outdir}: {len(names)} frames")
+            write_drawn(args.json, drawn)
             return 0
         if not -len(names) <= args.index < len(names):
             print(f"render_snapshot.py: no snapshot {args.index} ({len(names)} in the file)",
@@ -224,7 +258,8 @@ def main(argv=None):
         speed = np.hypot(snap["velocity"][:, 0], snap["velocity"][:, 1])
         out = args.output or os.path.join(base, f"snapshot_{snap['name']}.png")
         render(snap, materials, drum, args.color, float(speed.max()) if len(speed) else 0.0, out,
-               args.size, args.dpi)
+               args.size, args.dpi, drawn)
+        write_drawn(args.json, drawn)
         print(f"{out}: snapshot {snap['name']}, t = {snap['time']:.6g} s, {len(speed)} particles")
     return 0
 

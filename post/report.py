@@ -12,7 +12,8 @@ writes into REPORTDIR (default OUTDIR/report):
   charge_shape.png    toe and shoulder angles, bed surface angle, airborne and corotating
                       fractions against time, the regime as coloured bands;
   charge_TTT.TTTs.png the charge at a few snapshot times (evenly spaced, the last included):
-                      particles at their true radius coloured by speed [m/s], drum and lifters;
+                      particles at their true size coloured by speed [m/s] (discs as circles,
+                      superellipses as their outlines at their angles), drum and lifters;
   collisions.png      collision energy spectra per contact type (when collisions.csv exists);
   charge.mp4          an animation of the charge (at most --max-frames frames, default 200);
                       charge.gif instead when ffmpeg is not on the PATH;
@@ -364,8 +365,8 @@ def write_animation(run, f, names, vmax, path, max_frames):
     with writer.saving(fig, path, dpi=100):
         for name in frames:
             snap = millplot.read_snapshot(f, name)
-            if circles is not None:  # the rows may change order and size between snapshots
-                circles.remove()
+            for c in circles or []:  # the rows may change order and size between snapshots
+                c.remove()
             circles = millplot.particle_collection(ax, snap, vmax)
             outline = millplot.read_outline(f, name)
             if outline is None:

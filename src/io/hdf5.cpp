@@ -263,11 +263,12 @@ ParallelFile::DatasetShape ParallelFile::dataset_shape(const std::string& name) 
   const H5T_class_t cls = H5Tget_class(type.get());
   const std::size_t size = H5Tget_size(type.get());
   DatasetShape shape{"", dims[0], rank == 2 ? static_cast<std::size_t>(dims[1]) : 1};
-  if (cls == H5T_FLOAT && size == 8) shape.type = "double";
+  if (cls == H5T_FLOAT && (size == 8 || size == 4)) shape.type = size == 8 ? "double" : "float";
   if (cls == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_2 && (size == 8 || size == 4))
     shape.type = size == 8 ? "int64" : "int32";
   if (shape.type.empty())
-    throw IoError(fmt::format("{}: cannot read '{}': not int64, int32 or double", path_, name));
+    throw IoError(
+        fmt::format("{}: cannot read '{}': not int64, int32, double or float", path_, name));
   return shape;
 }
 
@@ -316,6 +317,11 @@ void ParallelFile::write_rows(const std::string& name, const RowRange& range,
 void ParallelFile::write_rows(const std::string& name, const RowRange& range,
                               const std::int32_t* data, std::size_t columns) {
   write_rows_typed(name, range, H5T_STD_I32LE, H5T_NATIVE_INT32, data, columns);
+}
+
+void ParallelFile::write_rows(const std::string& name, const RowRange& range, const float* data,
+                              std::size_t columns) {
+  write_rows_typed(name, range, H5T_IEEE_F32LE, H5T_NATIVE_FLOAT, data, columns);
 }
 
 void ParallelFile::write_field(const std::string& name, const RowRange& range,

@@ -148,6 +148,9 @@ class ParallelFile {
                   std::size_t columns = 1);
   void write_rows(const std::string& name, const RowRange& range, const std::int32_t* data,
                   std::size_t columns = 1);
+  // Single precision (IEEE 754 binary32): drawing data, not state (snapshots.h5's outlines).
+  void write_rows(const std::string& name, const RowRange& range, const float* data,
+                  std::size_t columns = 1);
   // The first range.count items of the particle field `field` as the rows of the dataset
   // `name` (field_column: the field's type decides the element type and the columns), as
   // write_rows. Throws std::logic_error for a field field_column() cannot hold.
@@ -170,8 +173,8 @@ class ParallelFile {
   std::string read_string_attribute(const std::string& object, const std::string& attribute) const;
   // A 1-D dataset of fixed-length strings (what write_strings writes).
   std::vector<std::string> read_strings(const std::string& name) const;
-  // The element type and shape of the dataset `name`: type "int64", "int32" or "double"
-  // (IoError for any other), `rows` its first dimension, `columns` its second (1 for a 1-D
+  // The element type and shape of the dataset `name`: type "int64", "int32", "double" or
+  // "float" (IoError for any other), `rows` its first dimension, `columns` its second (1 for a 1-D
   // dataset; IoError for more than 2 dimensions).
   struct DatasetShape {
     std::string type;

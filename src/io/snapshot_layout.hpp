@@ -12,13 +12,18 @@
 
 namespace dem2d::snapshot_layout {
 
-// The groups of snapshots.h5: complete snapshots, their wall outlines, the XDMF helpers.
+// The groups of snapshots.h5: complete snapshots, their wall outlines, the particles' outlines
+// (scenes with shaped particles only), the XDMF helpers.
 inline const std::string kSnapshotsGroup = "/snapshots";
 inline const std::string kWallsGroup = "/walls";
+inline const std::string kOutlinesGroup = "/outlines";
 inline const std::string kXdmfGroup = "/xdmf";
 
 // The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
 inline constexpr const char* kGeometry = "position";
+// The points of each particle's outline polygon (core/shape/outline.hpp) in a snapshot of a
+// scene with shaped particles: /outlines/NNNNNN/points holds N x kOutlineVertices rows.
+inline constexpr std::uint64_t kOutlineVertices = 24;
 // The registry field of material rows: its datasets carry the material names (attribute names).
 inline constexpr const char* kMaterial = "material";
 
@@ -26,6 +31,12 @@ inline constexpr const char* kMaterial = "material";
 // The Xdmf3 readers make no cells without it (the points would not show as a surface).
 inline std::string polyvertex_dataset(std::uint64_t n) {
   return fmt::format("/xdmf/polyvertex_{}", n);
+}
+
+// The dataset holding the connectivity of n polygons of k points each, numbered one after the
+// other: row i is i k, i k + 1, ..., i k + k - 1 (the outlines' Polygon topology).
+inline std::string polygon_dataset(std::uint64_t k, std::uint64_t n) {
+  return fmt::format("/xdmf/polygon_{}_{}", k, n);
 }
 
 // "0=steel,1=iron ore": each material's row of /materials and its name (the `names` attribute

@@ -18,6 +18,7 @@
 #include <utility>
 
 #include "core/base/errors.hpp"
+#include "core/shape/outline.hpp"
 #include "io/output_dir.hpp"
 #include "io/snapshot_layout.hpp"
 #include "io/xdmf.hpp"
@@ -28,10 +29,13 @@ namespace {
 namespace fs = std::filesystem;
 using snapshot_layout::kGeometry;
 using snapshot_layout::kMaterial;
+using snapshot_layout::kOutlinesGroup;
+using snapshot_layout::kOutlineVertices;
 using snapshot_layout::kSnapshotsGroup;
 using snapshot_layout::kWallsGroup;
 using snapshot_layout::kXdmfGroup;
 using snapshot_layout::material_lookup;
+using snapshot_layout::polygon_dataset;
 using snapshot_layout::polyvertex_dataset;
 
 // The derived dataset every snapshot holds after the registry's: |velocity|.
@@ -46,6 +50,8 @@ const std::string kStagingGroup = "/incomplete";
 
 // Where snapshot NAME's wall outline is staged (beside its particles, /incomplete/NAME).
 std::string staged_walls(const std::string& name) { return kStagingGroup + "/walls_" + name; }
+// Where snapshot NAME's particle outlines are staged.
+std::string staged_outlines(const std::string& name) { return kStagingGroup + "/outlines_" + name; }
 
 // The n of a member "polyvertex_n" of /xdmf; std::nullopt for another name.
 std::optional<std::uint64_t> polyvertex_size(const std::string& member) {
@@ -54,6 +60,19 @@ std::optional<std::uint64_t> polyvertex_size(const std::string& member) {
   const std::string digits = member.substr(prefix.size());
   if (digits.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
   return std::stoull(digits);
+}
+
+// The (k, n) of a member "polygon_k_n" of /xdmf; std::nullopt for another name.
+std::optional<std::pair<std::uint64_t, std::uint64_t>> polygon_size(const std::string& member) {
+  const std::string prefix = "polygon_";
+  if (!member.starts_with(prefix)) return std::nullopt;
+  const std::string rest = member.substr(prefix.size());
+  const std::size_t split = rest.find('_');
+  if (split == 0 || split == std::string::npos || split + 1 == rest.size() ||
+      rest.find_first_not_of("0123456789_") != std::string::npos ||
+      rest.find('_', split + 1) != std::string::npos)
+    return std::nullopt;
+  return std::pair{std::stoull(rest.substr(0, split)), std::stoull(rest.substr(split + 1))};
 }
 
 // The number of a snapshot group's name (NNNNNN); std::nullopt for any other name.
@@ -242,6 +261,11 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   for (const SnapshotDataset& d : record.datasets)
     row_bytes += d.columns * (d.type == "int32" ? 4 : 8);
   const std::uint64_t total = h5::row_range(comm_, p.n_owned()).total;
+  if (p.shaped() && total > 0) {
+    record.outline_vertices = kOutlineVertices;
+    row_bytes += 8 * kOutlineVertices;  // the outline's points (float x, y)
+    if (!polygon_sizes_.contains({kOutlineVertices, total})) row_bytes += 8 * kOutlineVertices;
+  }
   ensure_free_space(comm_, h5_path_,
                     total * row_bytes + 16 * (record.wall_points + record.wall_segments) +
                         2048 * (record.datasets.size() + 2) + 16384);
@@ -259,6 +283,8 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   const bool sync = header[2] != 0;
   std::optional<std::vector<SnapshotInfo>> whole = publish(record, sync);
   if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
+  if (record.outline_vertices > 0)
+    polygon_sizes_.insert({record.outline_vertices, record.particles});
   last_ = record;
   ++written_;
   ++next_index_;
@@ -280,6 +306,8 @@ std::optional<std::vector<SnapshotInfo>> SnapshotWriter::publish(const SnapshotI
   try {
     if (record.wall_segments > 0)  // the outline first: a published snapshot has its outline
       file_->move_link(staged_walls(record.name), kWallsGroup + "/" + record.name);
+    if (record.outline_vertices > 0)  // likewise its particles' outlines
+      file_->move_link(staged_outlines(record.name), kOutlinesGroup + "/" + record.name);
     file_->move_link(kStagingGroup + "/" + record.name, kSnapshotsGroup + "/" + record.name);
     for (auto& [key, stored] : pending_) stored_[key] = std::move(stored);
     pending_.clear();
@@ -308,14 +336,19 @@ void SnapshotWriter::agree(const std::string& local_error) {
 // (its staging groups; its published groups if it failed after a move, before it was
 // recorded; a connectivity dataset no recorded snapshot uses), so the write can start afresh.
 void SnapshotWriter::clear_failed_write(const std::string& name) {
-  for (const std::string& g : {kStagingGroup + "/" + name, staged_walls(name),
-                               kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name}) {
+  const bool outlines = file_->link_exists(kOutlinesGroup);
+  for (const std::string& g :
+       {kStagingGroup + "/" + name, staged_walls(name), staged_outlines(name),
+        kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name, kOutlinesGroup + "/" + name}) {
+    if (g.starts_with(kOutlinesGroup + "/") && !outlines) continue;
     if (file_->link_exists(g)) file_->remove_link(g);
     std::erase_if(stored_, [&](const auto& s) { return s.second.path.starts_with(g + "/"); });
   }
   for (const std::string& member : file_->group_members(kXdmfGroup)) {
     const std::optional<std::uint64_t> n = polyvertex_size(member);
-    if (n && !polyvertex_sizes_.contains(*n)) file_->remove_link(kXdmfGroup + "/" + member);
+    const auto polygon = polygon_size(member);
+    if ((n && !polyvertex_sizes_.contains(*n)) || (polygon && !polygon_sizes_.contains(*polygon)))
+      file_->remove_link(kXdmfGroup + "/" + member);
   }
   failed_ = false;
 }
@@ -331,6 +364,11 @@ void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
   write_datasets(group, kSnapshotsGroup + "/" + record.name, rows, p, extra);
   if (rows.total > 0 && !polyvertex_sizes_.contains(rows.total)) write_polyvertex(rows);
   if (record.wall_segments > 0) write_walls(staged_walls(record.name), record, walls);
+  if (record.outline_vertices > 0) {
+    write_outlines(staged_outlines(record.name), record, rows, p);
+    if (!polygon_sizes_.contains({record.outline_vertices, rows.total}))
+      write_polygons(record.outline_vertices, rows);
+  }
   if (fail_before_dataset_) {  // testing: past the last dataset, fail before the flush
     fail_before_dataset_.reset();
     throw IoError(fmt::format("{}: cannot close '{}': injected failure", h5_path_, group));
@@ -451,6 +489,44 @@ void SnapshotWriter::write_polyvertex(const h5::RowRange& rows) {
   file_->write_rows(polyvertex_dataset(rows.total), rows, index.data());
 }
 
+// The outlines of the owned particles as the group `group` (core/shape/outline.hpp): the
+// points, record.outline_vertices rows per particle in the snapshot's row order, as floats
+// (the drawing needs no more; half the bytes).
+void SnapshotWriter::write_outlines(const std::string& group, const SnapshotInfo& record,
+                                    const h5::RowRange& rows, const ParticleStore& p) {
+  const std::uint64_t k = record.outline_vertices;
+  std::vector<Vec2> polygon(k);
+  std::vector<float> points(2 * k * rows.count);
+  for (std::size_t i = 0; i < rows.count; ++i) {
+    superellipse_outline({(*p.semi_a())[i], (*p.semi_b())[i], (*p.exponent())[i]}, p.pos[i],
+                         p.theta[i], polygon);
+    for (std::uint64_t j = 0; j < k; ++j) {
+      points[2 * (i * k + j)] = static_cast<float>(polygon[j].x);
+      points[2 * (i * k + j) + 1] = static_cast<float>(polygon[j].y);
+    }
+  }
+  if (!file_->link_exists(kOutlinesGroup)) file_->create_group(kOutlinesGroup);
+  file_->create_group(group);
+  file_->write_attribute(group, "time", record.time);
+  file_->write_attribute(group, "step", record.step);
+  const std::string name = group + "/points";
+  file_->write_rows(name, {rows.offset * k, rows.count * k, rows.total * k}, points.data(), 2);
+  file_->write_attribute(name, "unit", std::string("m"));
+  file_->write_attribute(
+      name, "doc",
+      fmt::format("x and y of each particle's outline, {} points per particle in the "
+                  "snapshot's row order, counter-clockwise, lab frame",
+                  k));
+}
+
+// /xdmf/polygon_K_N for N = rows.total: row i is i K, ..., i K + K - 1, each rank its rows.
+void SnapshotWriter::write_polygons(std::uint64_t vertices, const h5::RowRange& rows) {
+  std::vector<std::int64_t> index(rows.count * vertices);
+  for (std::uint64_t i = 0; i < index.size(); ++i)
+    index[i] = static_cast<std::int64_t>(rows.offset * vertices + i);
+  file_->write_rows(polygon_dataset(vertices, rows.total), rows, index.data(), vertices);
+}
+
 // resume(): empties /incomplete, drops the snapshots after `last_time`, records the others in
 // order and makes /xdmf hold exactly the connectivity they use.
 std::vector<SnapshotInfo> SnapshotWriter::drop_and_read(double last_time) {
@@ -486,6 +562,8 @@ std::vector<SnapshotInfo> SnapshotWriter::drop_and_read(double last_time) {
   }
   reconcile_polyvertex(kept);
   reconcile_walls(kept);
+  reconcile_outlines(kept);
+  reconcile_polygons(kept);
   return kept;
 }
 
@@ -501,6 +579,8 @@ std::vector<SnapshotInfo> SnapshotWriter::published_records() const {
   for (const auto& [index, name] : groups) {
     out.push_back(*read_record(name, std::numeric_limits<double>::infinity()));
     if (file_->link_exists(kWallsGroup + "/" + name)) read_walls(out.back());
+    if (file_->link_exists(kOutlinesGroup) && file_->link_exists(kOutlinesGroup + "/" + name))
+      read_outlines(out.back());
   }
   return out;
 }
@@ -563,6 +643,57 @@ void SnapshotWriter::read_walls(SnapshotInfo& record) const {
     throw IoError(fmt::format("{}: cannot resume: '{}' is not a wall outline", h5_path_, group));
   record.wall_points = points.rows;
   record.wall_segments = segments.rows;
+}
+
+// resume(): records the particle outlines of every kept snapshot that has them and removes the
+// others (those of dropped snapshots, or left by a write that failed between its moves).
+void SnapshotWriter::reconcile_outlines(std::vector<SnapshotInfo>& kept) {
+  if (!file_->link_exists(kOutlinesGroup)) return;  // no shaped particles
+  std::map<std::string, SnapshotInfo*> by_name;
+  for (SnapshotInfo& r : kept) by_name[r.name] = &r;
+  for (const std::string& member : file_->group_members(kOutlinesGroup)) {
+    const auto it = by_name.find(member);
+    if (it == by_name.end())
+      file_->remove_link(kOutlinesGroup + "/" + member);
+    else
+      read_outlines(*it->second);
+  }
+}
+
+// The points per particle of /outlines/NAME into `record` (NAME its name). Throws IoError for
+// a group that is not the outlines of the snapshot's particles.
+void SnapshotWriter::read_outlines(SnapshotInfo& record) const {
+  const std::string points = kOutlinesGroup + "/" + record.name + "/points";
+  const h5::ParallelFile::DatasetShape shape =
+      file_->link_exists(points) ? file_->dataset_shape(points) : h5::ParallelFile::DatasetShape{};
+  const std::uint64_t k = record.particles == 0 ? 0 : shape.rows / record.particles;
+  if (shape.type != "float" || shape.columns != 2 || k == 0 || k * record.particles != shape.rows)
+    throw IoError(fmt::format("{}: cannot resume: '{}/{}' is not the outlines of its snapshot",
+                              h5_path_, kOutlinesGroup, record.name));
+  record.outline_vertices = k;
+}
+
+// resume(): keeps the /xdmf/polygon_K_N the kept snapshots use, removes the others and writes
+// any that is missing.
+void SnapshotWriter::reconcile_polygons(const std::vector<SnapshotInfo>& kept) {
+  std::set<std::pair<std::uint64_t, std::uint64_t>> used;
+  for (const SnapshotInfo& r : kept)
+    if (r.outline_vertices > 0) used.insert({r.outline_vertices, r.particles});
+  for (const std::string& member : file_->group_members(kXdmfGroup)) {
+    const auto size = polygon_size(member);
+    if (!size) continue;
+    const std::string path = kXdmfGroup + "/" + member;
+    const h5::ParallelFile::DatasetShape shape = file_->dataset_shape(path);
+    if (used.contains(*size) && shape.rows == size->second && shape.columns == size->first)
+      polygon_sizes_.insert(*size);
+    else
+      file_->remove_link(path);
+  }
+  for (const auto& size : used) {
+    if (polygon_sizes_.contains(size)) continue;
+    write_polygons(size.first, h5::rank0_rows(comm_, size.second));
+    polygon_sizes_.insert(size);
+  }
 }
 
 // resume(): keeps the /xdmf/polyvertex_N the kept snapshots use (an unused one may be what a

@@ -23,30 +23,39 @@
 //                                        each a hard link to the last stored one when equal to
 //                                        it (the segments of a scene: always; the points: while
 //                                        the walls stand still)
-//   /incomplete/NNNNNN, /incomplete/walls_NNNNNN
-//                                        the snapshot being written and its outline (staging);
+//   /outlines/NNNNNN                     scenes with shaped particles (ParticleStore::shaped())
+//                                        and N > 0 only: attributes time, step;
+//       points   (N K x 2 float, m)      K = snapshot_layout::kOutlineVertices points of each
+//                                        particle's curve (core/shape/outline.hpp), lab frame,
+//                                        rows i K .. i K + K - 1 the particle of row i
+//   /incomplete/NNNNNN, /incomplete/walls_NNNNNN, /incomplete/outlines_NNNNNN
+//                                        the snapshot being written and its outlines (staging);
 //                                        empty between writes, except after a failed write
 //   /xdmf/polyvertex_N                   int64 0..N-1, the connectivity snapshots.xmf uses for
 //                                        its Polyvertex topology (one per particle count N)
+//   /xdmf/polygon_K_N                    int64 N x K, row i: i K .. i K + K - 1, the
+//                                        connectivity of the outlines' Polygon topology
 // N is the global number of owned particles; rank 0's particles come first, then rank 1's...
 //
 // Complete or absent. write() opens the file (MPI-IO, collectively), builds the snapshot in
-// /incomplete/NNNNNN and its outline in /incomplete/walls_NNNNNN, moves the outline's link to
-// /walls/NNNNNN and the snapshot's to /snapshots/NNNNNN (H5Lmove: no data is copied) and closes
-// the file, which writes out all of its metadata; only then does rank 0 list the snapshot in
-// snapshots.xmf. Between writes the file is closed and whole, so a run killed then leaves every
-// listed snapshot readable. A write that fails part-way (disk full) leaves at most partial
-// groups under /incomplete, never under /snapshots: everything under /snapshots is a complete
-// snapshot. Readers (post/*.py) list /snapshots only. Syncing to disk (fsync) is what a
-// snapshot would otherwise cost most: write() syncs both files (H5Fflush before the close, then
-// snapshots.xmf and the folder) only when kSyncInterval of wall time (rank 0's clock) has
-// passed since the last sync, and close() syncs them at the end.
+// /incomplete/NNNNNN and its outlines in /incomplete/walls_NNNNNN and outlines_NNNNNN, moves
+// the outlines' links to /walls/NNNNNN and /outlines/NNNNNN and the snapshot's to /snapshots/NNNNNN
+// (H5Lmove: no data is copied) and closes the file, which writes out all of its metadata; only then
+// does rank 0 list the snapshot in snapshots.xmf. Between writes the file is closed and whole, so a
+// run killed then leaves every listed snapshot readable. A write that fails part-way (disk full)
+// leaves at most partial groups under /incomplete, never under /snapshots: everything under
+// /snapshots is a complete snapshot. Readers (post/*.py) list /snapshots only. Syncing to disk
+// (fsync) is what a snapshot would otherwise cost most: write() syncs both files (H5Fflush before
+// the close, then snapshots.xmf and the folder) only when kSyncInterval of wall time (rank 0's
+// clock) has passed since the last sync, and close() syncs them at the end.
 //
 // snapshots.xmf (XDMF 3): a temporal collection with, per snapshot, a spatial collection at its
-// time of two grids: "particles", a Polyvertex grid with XY geometry from position, every
-// other dataset as a point attribute (a Vec2 field, e.g. velocity, as a 2-component Vector) and
-// one field-data value "material: NAME" (its row) per material; and "walls", the outline as a
-// Polyline grid of 2-node segments (absent when the snapshot has none). The domain's
+// time of up to three grids: "particles", a Polyvertex grid with XY geometry from position,
+// every other dataset as a point attribute (a Vec2 field, e.g. velocity, as a 2-component
+// Vector) and one field-data value "material: NAME" (its row) per material; "outlines" (when
+// the snapshot has /outlines), a Polygon grid of one K-node cell per particle with every
+// dataset of the snapshot as a cell attribute and the same field data; and "walls", the outline
+// as a Polyline grid of 2-node segments (absent when the snapshot has none). The domain's
 // <Information Name="material_names" Value="0=steel,1=ore"/> names the materials too. Checked
 // with ParaView 5.11's "XDMF Reader" and "Xdmf3 Reader S/T". It lists exactly the snapshots
 // under /snapshots, and only after they are there. Rank 0 creates it whole with the first
@@ -70,6 +79,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/base/scene.hpp"
@@ -115,6 +125,9 @@ struct SnapshotInfo {
   std::vector<SnapshotDataset> datasets;  // in the group's order: registry fields, speed, extras
   std::uint64_t wall_points = 0;          // M: rows of /walls/NNNNNN/points
   std::uint64_t wall_segments = 0;        // S: rows of /walls/NNNNNN/segments; 0: no outline
+  // K: the points of each particle's outline, /outlines/NNNNNN/points holding N K rows; 0: no
+  // outlines (a scene without shaped particles, or no particles)
+  std::uint64_t outline_vertices = 0;
 };
 
 class SnapshotWriter {
@@ -130,13 +143,13 @@ class SnapshotWriter {
   // /materials (`materials` is not used: snapshots.xmf names the file's /materials/name),
   // deletes every /snapshots group whose `time` attribute is > time + tolerance (the
   // interrupted run wrote it after the checkpoint), every staging group under /incomplete, the
-  // /xdmf/polyvertex_N no kept snapshot uses and the /walls/NNNNNN of no kept snapshot; keeps
-  // the rest, numbers the next snapshot after the highest kept one, regenerates snapshots.xmf
-  // (temporary file and rename) to list exactly the kept snapshots (removes it when none is
-  // kept), and appends in O(1) from there. When DIR/snapshots.h5 does not exist, it is the
-  // constructor above. Throws IoError on every rank, with the same message naming the file,
-  // when the file cannot be opened ("cannot open DIR/snapshots.h5: REASON") or is not a
-  // snapshot file ("DIR/snapshots.h5: cannot ...").
+  // /xdmf/polyvertex_N and polygon_K_N no kept snapshot uses and the /walls/NNNNNN and
+  // /outlines/NNNNNN of no kept snapshot; keeps the rest, numbers the next snapshot after the
+  // highest kept one, regenerates snapshots.xmf (temporary file and rename) to list exactly the
+  // kept snapshots (removes it when none is kept), and appends in O(1) from there. When
+  // DIR/snapshots.h5 does not exist, it is the constructor above. Throws IoError on every rank,
+  // with the same message naming the file, when the file cannot be opened ("cannot open
+  // DIR/snapshots.h5: REASON") or is not a snapshot file ("DIR/snapshots.h5: cannot ...").
   static std::unique_ptr<SnapshotWriter> resume(MPI_Comm comm, const std::string& directory,
                                                 const std::vector<MaterialSpec>& materials,
                                                 double time, double tolerance);
@@ -204,12 +217,18 @@ class SnapshotWriter {
                       const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
   void write_polyvertex(const h5::RowRange& rows);
+  void write_outlines(const std::string& group, const SnapshotInfo& record,
+                      const h5::RowRange& rows, const ParticleStore& p);
+  void write_polygons(std::uint64_t vertices, const h5::RowRange& rows);
   void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
   void agree(const std::string& local_error);                 // IoError on every rank if any failed
   std::vector<SnapshotInfo> drop_and_read(double last_time);  // resume: the file's part
   std::optional<SnapshotInfo> read_record(const std::string& name, double last_time) const;
   void reconcile_polyvertex(const std::vector<SnapshotInfo>& kept);
   void reconcile_walls(std::vector<SnapshotInfo>& kept);
+  void reconcile_outlines(std::vector<SnapshotInfo>& kept);
+  void reconcile_polygons(const std::vector<SnapshotInfo>& kept);
+  void read_outlines(SnapshotInfo& record) const;
 
   MPI_Comm comm_;
   int rank_ = 0;
@@ -225,7 +244,8 @@ class SnapshotWriter {
   bool closed_ = false;                       // close() was called
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
-  bool failed_ = false;                       // the last write failed: clear its remains first
+  std::set<std::pair<std::uint64_t, std::uint64_t>> polygon_sizes_;  // (k, n): polygon_k_n
+  bool failed_ = false;  // the last write failed: clear its remains first
   std::optional<std::size_t> fail_before_dataset_;  // fail_before_dataset_for_testing
 };
 

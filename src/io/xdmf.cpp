@@ -22,9 +22,11 @@ namespace {
 namespace fs = std::filesystem;
 using snapshot_layout::kGeometry;
 using snapshot_layout::kMaterial;
+using snapshot_layout::kOutlinesGroup;
 using snapshot_layout::kSnapshotsGroup;
 using snapshot_layout::kWallsGroup;
 using snapshot_layout::material_lookup;
+using snapshot_layout::polygon_dataset;
 using snapshot_layout::polyvertex_dataset;
 
 // snapshots.xmf is xdmf_header(), one grid per snapshot (xdmf_grid), kXdmfTrailer.
@@ -88,17 +90,17 @@ std::string hdf_item(const std::string& h5_name, const std::string& dataset, std
       dims, number_type, precision, h5_name, dataset);
 }
 
-// An attribute of the points: "Scalar" (N values) or "Vector" (N x 2 values). A 2-component
-// vector is valid XDMF; ParaView's "XDMF Reader" pads it to 3 components (z = 0), its
-// "Xdmf3 Reader S/T" keep 2 components.
-std::string point_attribute(const std::string& attribute, const std::string& h5_name,
-                            const std::string& dataset, std::uint64_t rows, int columns,
-                            const char* number_type, int precision) {
+// An attribute of the points (center "Node") or of the cells ("Cell"): "Scalar" (N values) or
+// "Vector" (N x 2 values). A 2-component vector is valid XDMF; ParaView's "XDMF Reader" pads
+// it to 3 components (z = 0), its "Xdmf3 Reader S/T" keep 2 components.
+std::string attribute(const char* center, const std::string& attribute, const std::string& h5_name,
+                      const std::string& dataset, std::uint64_t rows, int columns,
+                      const char* number_type, int precision) {
   return fmt::format(
-      "          <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n"
+      "          <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"{}\">\n"
       "            {}\n"
       "          </Attribute>\n",
-      attribute, columns == 1 ? "Scalar" : "Vector",
+      attribute, columns == 1 ? "Scalar" : "Vector", center,
       hdf_item(h5_name, dataset, rows, columns, number_type, precision));
 }
 
@@ -140,8 +142,35 @@ std::string particles_grid(const std::string& h5, const SnapshotInfo& r,
   for (const SnapshotDataset& d : r.datasets) {
     if (d.name == kGeometry) continue;
     const auto [number_type, precision] = xdmf_number(d.type);
-    text += point_attribute(d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
-                            number_type, precision);
+    text += attribute("Node", d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
+                      number_type, precision);
+  }
+  return text + material_attributes(material_names) + "        </Grid>\n";
+}
+
+// The particles' outlines of one snapshot: a Polygon topology of K nodes per cell, one cell per
+// particle (the connectivity /xdmf/polygon_K_N), the XY points /outlines/NNNNNN/points, and
+// every dataset of the snapshot as a cell attribute (the cells are in the snapshot's row order:
+// no data is repeated), the material names as field data.
+std::string outlines_grid(const std::string& h5, const SnapshotInfo& r,
+                          const std::vector<std::string>& material_names) {
+  const std::string g = kSnapshotsGroup + "/" + r.name;
+  const std::uint64_t n = r.particles, k = r.outline_vertices;
+  std::string text = fmt::format(
+      "        <Grid Name=\"outlines\" GridType=\"Uniform\">\n"
+      "          <Topology TopologyType=\"Polygon\" NumberOfElements=\"{}\" "
+      "NodesPerElement=\"{}\">\n"
+      "            {}\n"
+      "          </Topology>\n"
+      "          <Geometry GeometryType=\"XY\">\n"
+      "            {}\n"
+      "          </Geometry>\n",
+      n, k, hdf_item(h5, polygon_dataset(k, n), n, static_cast<int>(k), "Int", 8),
+      hdf_item(h5, kOutlinesGroup + "/" + r.name + "/points", n * k, 2, "Float", 4));
+  for (const SnapshotDataset& d : r.datasets) {
+    const auto [number_type, precision] = xdmf_number(d.type);
+    text += attribute("Cell", d.name, h5, g + "/" + d.name, n, static_cast<int>(d.columns),
+                      number_type, precision);
   }
   return text + material_attributes(material_names) + "        </Grid>\n";
 }
@@ -165,8 +194,9 @@ std::string walls_grid(const std::string& h5, const SnapshotInfo& r) {
 }
 
 // The <Grid> of one snapshot in snapshots.xmf, a spatial collection at the snapshot's time of
-// the particles and (when the snapshot has one) the wall outline; `h5` is the HDF5 file's name.
-// ParaView's three XDMF readers show it as a multiblock of two blocks per time step.
+// the particles, (when the snapshot has them) the particles' outlines and (when the snapshot
+// has one) the wall outline; `h5` is the HDF5 file's name. ParaView's three XDMF readers show
+// it as a multiblock of one block per grid at each time step.
 std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
                       const std::vector<std::string>& material_names) {
   std::string text = fmt::format(
@@ -174,6 +204,7 @@ std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
       "        <Time Value=\"{:.17g}\"/>\n",
       r.name, r.time);
   text += particles_grid(h5, r, material_names);
+  if (r.outline_vertices > 0) text += outlines_grid(h5, r, material_names);
   if (r.wall_segments > 0) text += walls_grid(h5, r);
   return text + "      </Grid>\n";
 }

@@ -5,16 +5,21 @@
 
 Parses the XDMF with xml.etree and checks, with h5py: the document's shape (one temporal
 collection of spatial collections, each at a time not before the previous one, holding a
-"particles" grid and, when the snapshot has an outline, a "walls" grid); that every HDF
-DataItem names a dataset of the HDF5 file (path relative to the .xmf) with exactly the stated
-Dimensions, NumberType and Precision; that every XML DataItem holds as many numbers as its
-Dimensions say; that topologies, geometries and attributes agree on their sizes and the
-connectivity stays within the points; that the grids are exactly the file's /snapshots and
-/walls groups; and that the material names (Information and the grids' field data) are the
-file's /materials/name. With --paraview, also opens the file with ParaView's three XDMF readers
-(python3-paraview) and checks what each shows at every time step.
+"particles" grid, an "outlines" grid when the snapshot has particle outlines, and a "walls"
+grid when it has a wall outline); that every HDF DataItem names a dataset of the HDF5 file
+(path relative to the .xmf) with exactly the stated Dimensions, NumberType and Precision;
+that every XML DataItem holds as many numbers as its Dimensions say; that topologies,
+geometries and attributes agree on their sizes and the connectivity stays within the points;
+that the grids are exactly the file's /snapshots, /outlines and /walls groups; that each
+particle's outline polygon (its cell of the "outlines" grid, in the snapshot's row order) is
+counter-clockwise, centred on the particle's position and of the area of its superellipse
+(semi_axis_a, semi_axis_b, exponent) less the polygon's discretisation (at most 1.5 %: an
+inscribed polygon); and that the material names (Information and the grids' field data) are
+the file's /materials/name. With --paraview, also opens the file with ParaView's three XDMF
+readers (python3-paraview) and checks what each shows at every time step.
 
-Run by tests/io/test_output.cpp (XdmfSidecar.EveryDataItemMatchesTheHdf5File). Exit status: 0
+Run by tests/io/test_output.cpp (XdmfSidecar.EveryDataItemMatchesTheHdf5File,
+SnapshotWriter.ShapedParticlesCarryTheirShapeAndOutlines). Exit status: 0
 when every check passes, 1 otherwise (each problem printed), 2 for a usage error.
 """
 
@@ -27,7 +32,14 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-DTYPES = {("Float", "8"): np.dtype("<f8"), ("Int", "8"): np.dtype("<i8"), ("Int", "4"): np.dtype("<i4")}
+DTYPES = {("Float", "8"): np.dtype("<f8"), ("Float", "4"): np.dtype("<f4"), ("Int", "8"): np.dtype("<i8"),
+          ("Int", "4"): np.dtype("<i4")}
+
+
+def superellipse_area(a, b, n):
+    """4ab Gamma(1+1/n)^2 / Gamma(1+2/n), elementwise."""
+    g = np.vectorize(math.gamma)
+    return 4.0 * a * b * g(1.0 + 1.0 / n) ** 2 / g(1.0 + 2.0 / n)
 
 
 class Checker:
@@ -87,10 +99,11 @@ class Checker:
         elements = int(topology.get("NumberOfElements"))
         nodes = int(topology.get("NodesPerElement"))
         kind = topology.get("TopologyType")
-        expected = {"particles": ("Polyvertex", 1), "walls": ("Polyline", 2)}.get(grid.get("Name"))
+        expected = {"particles": ("Polyvertex", 1), "walls": ("Polyline", 2),
+                    "outlines": ("Polygon", max(nodes, 3))}.get(grid.get("Name"))
         if expected != (kind, nodes):
             self.fail(where, f"grid {grid.get('Name')} has topology {kind} of {nodes} nodes")
-        item = topology.find("DataItem")
+        item, cells = topology.find("DataItem"), None
         if item is None:
             if elements != 0 or n_points != 0:
                 self.fail(where, f"no connectivity for {elements} elements of {n_points} points")
@@ -101,22 +114,53 @@ class Checker:
                     self.fail(where, f"{cells.size} connectivity values for {elements} x {nodes}")
                 if cells.size and (cells.min() < 0 or cells.max() >= n_points):
                     self.fail(where, f"connectivity outside the {n_points} points")
-        fields = []
+        fields, cell_values = [], {}
         for attribute in grid.findall("Attribute"):
             at = f"{where}/Attribute[{attribute.get('Name')}]"
             values = self.data_item(attribute.find("DataItem"), at, h5)
             center = attribute.get("Center")
+            want_center = "Cell" if grid.get("Name") == "outlines" else "Node"
             if center == "Grid":
                 fields.append((attribute.get("Name"), values))
-            elif center != "Node":
+            elif center != want_center:
                 self.fail(at, f"Center {center}")
             elif values is not None:
-                if values.shape[0] != n_points:
-                    self.fail(at, f"{values.shape[0]} values for {n_points} points")
+                rows = elements if center == "Cell" else n_points
+                if values.shape[0] != rows:
+                    self.fail(at, f"{values.shape[0]} values for {rows} {center.lower()}s")
+                cell_values[attribute.get("Name")] = values
                 want = "Scalar" if values.ndim == 1 else "Vector"
                 if attribute.get("AttributeType") != want:
                     self.fail(at, f"AttributeType {attribute.get('AttributeType')}, not {want}")
+        if grid.get("Name") == "outlines" and points is not None and item is not None and cells is not None:
+            self.outlines(where, points, cells.reshape(elements, nodes), cell_values)
         return grid.get("Name"), n_points, elements, fields
+
+    def outlines(self, where, points, cells, values):
+        """Each cell a counter-clockwise polygon centred on its particle's position with nearly
+        the area of its superellipse."""
+        missing = {"position", "semi_axis_a", "semi_axis_b", "exponent"} - set(values)
+        if missing:
+            self.fail(where, f"no cell attributes {sorted(missing)}")
+            return
+        if cells.size == 0:
+            return
+        x, y = points[cells, 0].astype(float), points[cells, 1].astype(float)  # (N, K)
+        area = 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
+        exact = superellipse_area(values["semi_axis_a"], values["semi_axis_b"], values["exponent"])
+        ratio = area / exact
+        bad = np.flatnonzero((ratio < 0.985) | (ratio > 1.0))
+        if bad.size:
+            self.fail(where, f"{bad.size} outlines whose area is not their superellipse's "
+                      f"(row {bad[0]}: {area[bad[0]]:.6g} m^2, the superellipse {exact[bad[0]]:.6g})")
+        size = np.maximum(values["semi_axis_a"], values["semi_axis_b"])
+        centre = np.stack([x.mean(axis=1), y.mean(axis=1)], axis=1)
+        off = np.linalg.norm(centre - values["position"], axis=1)
+        scale = 1e-6 * (np.abs(values["position"]).max(axis=1) + size)
+        bad = np.flatnonzero(off > scale)
+        if bad.size:
+            self.fail(where, f"{bad.size} outlines not centred on their particle (row {bad[0]}: "
+                      f"{off[bad[0]]:.3g} m off)")
 
     def document(self, h5):
         try:
@@ -136,7 +180,7 @@ class Checker:
         if len(temporal) != 1 or temporal[0].get("CollectionType") != "Temporal":
             self.fail("/Domain", "not one temporal collection")
             return
-        last, seen_snapshots, seen_walls = -math.inf, [], []
+        last, seen_snapshots, seen_walls, seen_outlines = -math.inf, [], [], []
         for step in temporal[0].findall("Grid"):
             where = f"/Domain/Grid/Grid[{step.get('Name')}]"
             if step.get("CollectionType") != "Spatial":
@@ -149,12 +193,22 @@ class Checker:
             snapshot = step.get("Name").removeprefix("snapshot_")
             grids = [self.grid(g, f"{where}/Grid[{g.get('Name')}]", h5) for g in step.findall("Grid")]
             kinds = [g[0] for g in grids if g]
-            if kinds not in (["particles"], ["particles", "walls"]):
+            if kinds not in (["particles"], ["particles", "walls"], ["particles", "outlines"],
+                             ["particles", "outlines", "walls"]):
                 self.fail(where, f"grids {kinds}")
                 continue
             seen_snapshots.append(snapshot)
             if "walls" in kinds:
                 seen_walls.append(snapshot)
+            if "outlines" in kinds:
+                seen_outlines.append(snapshot)
+                outline = grids[1]
+                n = h5["snapshots"][snapshot]["id"].shape[0]
+                k = h5["outlines"][snapshot]["points"].shape[0] // max(n, 1)
+                if outline[2] != n or outline[1] != n * k:
+                    self.fail(where, f"outlines of {outline[2]} cells, {outline[1]} points for {n} particles")
+                if dict(outline[3]).keys() != dict(grids[0][3]).keys():
+                    self.fail(where, "outlines' material field data differ from the particles'")
             if float(h5["snapshots"][snapshot].attrs["time"]) != time:
                 self.fail(where, "time differs from the group's attribute")
             fields = dict(grids[0][3])
@@ -166,14 +220,20 @@ class Checker:
         walls = sorted(h5["walls"]) if "walls" in h5 else []
         if seen_walls != walls:
             self.fail("/Domain/Grid", f"walls of {seen_walls}, the file holds {walls}")
+        outlines = sorted(h5["outlines"]) if "outlines" in h5 else []
+        if seen_outlines != outlines:
+            self.fail("/Domain/Grid", f"outlines of {seen_outlines}, the file holds {outlines}")
         return seen_snapshots
 
 
 def check_paraview(xmf, h5, snapshots, problems):
     """Opens `xmf` with ParaView's three XDMF readers; each must show, at every time step, the
-    particles (a point per particle) and the outline (a cell per segment)."""
+    particles (a point per particle), their outlines (a polygon cell per particle, its points,
+    speed as cell data, each cell of the area of its polygon in the file) and the wall outline
+    (a cell per segment)."""
     from paraview import servermanager
     from paraview import simple
+    from vtkmodules.vtkFiltersVerdict import vtkCellSizeFilter
 
     readers = {"XDMF Reader": lambda: simple.XDMFReader(FileNames=[xmf]),
                "Xdmf3 Reader S": lambda: simple.Xdmf3ReaderS(FileName=[xmf]),
@@ -196,10 +256,25 @@ def check_paraview(xmf, h5, snapshots, problems):
             it.InitTraversal()
             while not it.IsDoneWithTraversal():
                 ds = it.GetCurrentDataObject()
-                blocks.append((ds.GetNumberOfPoints(), ds.GetNumberOfCells(), ds.GetPointData().GetArray("speed") is not None))
+                speed = ds.GetPointData().GetArray("speed") is not None or ds.GetCellData().GetArray("speed") is not None
+                blocks.append((ds.GetNumberOfPoints(), ds.GetNumberOfCells(), speed))
+                if "outlines" in h5 and name in h5["outlines"] and ds.GetNumberOfCells() and ds.GetCellType(0) == 7:
+                    sizes = vtkCellSizeFilter()  # the polygons as ParaView sees them
+                    sizes.SetInputData(ds)
+                    sizes.SetComputeArea(True)
+                    sizes.Update()
+                    area = sizes.GetOutput().GetCellData().GetArray("Area")
+                    seen = np.array([area.GetValue(i) for i in range(area.GetNumberOfTuples())])
+                    pts = h5["outlines"][name]["points"][()].astype(float).reshape(len(seen), -1, 2)
+                    x, y = pts[..., 0], pts[..., 1]
+                    want_area = 0.5 * np.abs((x * np.roll(y, -1, 1) - np.roll(x, -1, 1) * y).sum(1))
+                    if not np.allclose(seen, want_area, rtol=1e-9, atol=0):
+                        problems.append(f"{label}: snapshot {name}: ParaView's polygon areas differ from the file's")
                 it.GoToNextItem()
             n = h5["snapshots"][name]["id"].shape[0]
             want = [(n, n, True)]
+            if "outlines" in h5 and name in h5["outlines"]:
+                want.append((h5["outlines"][name]["points"].shape[0], n, True))
             if "walls" in h5 and name in h5["walls"]:
                 w = h5["walls"][name]
                 want.append((w["points"].shape[0], w["segments"].shape[0], False))

@@ -17,6 +17,9 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <memory>
+#include <numbers>
+#include <optional>
 #include <set>
 #include <span>
 #include <sstream>
@@ -25,11 +28,15 @@
 
 #include "core/base/errors.hpp"
 #include "core/base/scene.hpp"
+#include "core/run/simulation.hpp"
+#include "core/shape/outline.hpp"
 #include "core/shape/particles.hpp"
+#include "core/shape/superellipse.hpp"
 #include "io/hdf5.hpp"
 #include "io/output_dir.hpp"
 #include "io/series.hpp"
 #include "io/snapshots.hpp"
+#include "parallel/mpi_domain.hpp"
 #include "support/thesis.hpp"
 
 namespace dem2d {
@@ -546,8 +553,9 @@ TEST(SnapshotWriter, EveryRegistryFieldMarkedForOutputIsWrittenWithItsUnit) {
   EXPECT_EQ(described, datasets);
 }
 
-// docs/output.md's table of snapshot datasets is the registry's, row for row (run the test
-// to see the rows to paste when a field changes).
+// docs/output.md's table of snapshot datasets is the registry's, row for row, with the fields
+// a scene with shaped particles adds (run the test to see the rows to paste when a field
+// changes).
 TEST(SnapshotWriter, OutputDocsListExactlyTheRegistryDatasets) {
   if (comm_rank() != 0) return;
   const std::string docs = read_text(std::string(DEM2D_SOURCE_DIR) + "/docs/output.md");
@@ -560,7 +568,9 @@ TEST(SnapshotWriter, OutputDocsListExactlyTheRegistryDatasets) {
     if (line.starts_with("| `")) documented.insert(line);
   std::set<std::string> expected_rows;
   std::string table;
-  for (const SnapshotDataset& d : snapshot_datasets(ParticleStore{})) {
+  ParticleStore shaped;
+  shaped.enable_shape();
+  for (const SnapshotDataset& d : snapshot_datasets(shaped)) {
     const std::string shape = d.columns == 1 ? "(N)" : "(N, " + std::to_string(d.columns) + ")";
     const std::string row =
         "| `" + d.name + "` | " + d.type + " | " + shape + " | " + d.unit + " | " + d.doc + " |";
@@ -1096,6 +1106,246 @@ TEST(XdmfSidecar, EveryDataItemMatchesTheHdf5File) {
     write_version(writer, 3, 0, 0.0, false, true);
   }
   check("without materials");
+}
+
+// --- Shaped particles ---------------------------------------------------------------------
+
+// Global particle k of a mixed scene at snapshot `version`: every third a disc, the others
+// ellipses and rounded boxes (exponents 2, 4, 12, 50), each turned by its own angle.
+struct ShapedExpected {
+  std::int64_t id;
+  Vec2 pos;
+  double a, b, n, angle;
+  bool disc;
+};
+
+ShapedExpected shaped_expected(int k, int version) {
+  const double v = version;
+  const bool disc = k % 3 == 0;
+  const double exponents[] = {2.0, 4.0, 12.0, 50.0};
+  const double a = 0.01 * (k + 2), b = disc ? a : 0.004 * (k + 1);
+  return {500 + 3 * k,
+          {0.05 * k - 0.2 + v / 9.0, 0.03 * k + v / 7.0},
+          a,
+          b,
+          disc ? 2.0 : exponents[k % 4],
+          disc ? 0.1 * v : 0.4 * k - 1.3 + v / 3.0,
+          disc};
+}
+
+// This rank's particles (contiguous blocks) of the mixed scene at `version` in a shaped store.
+void fill_shaped(ParticleStore& store, int n, int version) {
+  store.enable_shape();
+  for (int k = 0; k < n; ++k) {
+    if (block_owner(k, n) != comm_rank()) continue;
+    const ShapedExpected e = shaped_expected(k, version);
+    if (e.disc) {
+      const std::size_t i = store.add(e.id, 0, e.a, 7800.0, e.pos, {0.5, -0.25 * k}, 1.0);
+      store.theta[i] = e.angle;
+    } else {
+      store.add_shaped(e.id, 1, e.a, e.b, e.n, 7800.0, e.pos, {0.5, -0.25 * k}, 1.0, e.angle);
+    }
+  }
+  const std::size_t g = store.add_ghosts(1);  // a ghost: never written
+  store.id[g] = -1;
+  store.pos[g] = {1e9, 1e9};
+}
+
+void write_shaped(SnapshotWriter& w, int n, int version, double time) {
+  ParticleStore p;
+  fill_shaped(p, n, version);
+  w.write(p, time, 100 * version);
+}
+
+// The area of the polygon of `k` points starting at row `first` of `xy` (x, y, x, y, ...).
+double polygon_area(const std::vector<float>& xy, std::size_t first, std::size_t k) {
+  double twice = 0.0;
+  for (std::size_t j = 0; j < k; ++j) {
+    const std::size_t p = 2 * (first + j), q = 2 * (first + (j + 1) % k);
+    twice += static_cast<double>(xy[p]) * xy[q + 1] - static_cast<double>(xy[q]) * xy[p + 1];
+  }
+  return 0.5 * twice;
+}
+
+// Checks /snapshots/NAME and /outlines/NAME against the mixed scene at `version`: the shape
+// datasets (discs a = b = r, n = 2) with their units; the outline's points, 24 per particle in
+// row order, each the float of superellipse_outline's point; each polygon counter-clockwise
+// with the superellipse's area less at most 1.5 %; the connectivity the outlines' grid uses.
+void check_shaped_snapshot(hid_t file, const std::string& name, int n, int version) {
+  SCOPED_TRACE("snapshot " + name);
+  const std::string g = "/snapshots/" + name;
+  const auto un = static_cast<hsize_t>(n);
+  Dims dims;
+  const auto a = read_dataset<double>(file, g + "/semi_axis_a", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(dims, (Dims{un}));
+  const auto b = read_dataset<double>(file, g + "/semi_axis_b", H5T_NATIVE_DOUBLE, dims);
+  const auto ex = read_dataset<double>(file, g + "/exponent", H5T_NATIVE_DOUBLE, dims);
+  const auto angle = read_dataset<double>(file, g + "/angle", H5T_NATIVE_DOUBLE, dims);
+  const auto radius = read_dataset<double>(file, g + "/radius", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(read_string_attribute(file, g + "/semi_axis_a", "unit"), "m");
+  EXPECT_EQ(read_string_attribute(file, g + "/semi_axis_b", "unit"), "m");
+  EXPECT_EQ(read_string_attribute(file, g + "/exponent", "unit"), "1");
+  const std::string o = "/outlines/" + name + "/points";
+  const auto xy = read_dataset<float>(file, o, H5T_NATIVE_FLOAT, dims);
+  const std::size_t k = 24;
+  EXPECT_EQ(dims, (Dims{un * k, 2}));
+  EXPECT_EQ(read_string_attribute(file, o, "unit"), "m");
+  {
+    H5Closer d{H5Dopen2(file, o.c_str(), H5P_DEFAULT), H5Dclose};
+    H5Closer t{H5Dget_type(d.id), H5Tclose};
+    EXPECT_TRUE(H5Tequal(t.id, H5T_IEEE_F32LE) > 0) << "little-endian floats";
+  }
+  const auto cells = read_dataset<std::int64_t>(file, "/xdmf/polygon_24_" + std::to_string(n),
+                                                H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{un, k}));
+  ASSERT_EQ(a.size(), un);
+  ASSERT_EQ(xy.size(), 2 * k * un);
+  ASSERT_EQ(cells.size(), k * un);
+  for (std::size_t i = 0; i < cells.size(); ++i) EXPECT_EQ(cells[i], static_cast<std::int64_t>(i));
+  std::vector<Vec2> polygon(k);
+  for (int kk = 0; kk < n; ++kk) {
+    const auto i = static_cast<std::size_t>(kk);
+    const ShapedExpected e = shaped_expected(kk, version);
+    EXPECT_EQ(a[i], e.a) << "k=" << kk;
+    EXPECT_EQ(b[i], e.b) << "k=" << kk;
+    EXPECT_EQ(ex[i], e.n) << "k=" << kk;
+    EXPECT_EQ(angle[i], e.angle) << "k=" << kk;
+    if (e.disc) {
+      EXPECT_EQ(radius[i], e.a) << "k=" << kk;
+    }
+    const SuperEllipse s{e.a, e.b, e.n};
+    superellipse_outline(s, e.pos, e.angle, polygon);
+    for (std::size_t j = 0; j < k; ++j) {
+      EXPECT_EQ(xy[2 * (i * k + j)], static_cast<float>(polygon[j].x)) << "k=" << kk;
+      EXPECT_EQ(xy[2 * (i * k + j) + 1], static_cast<float>(polygon[j].y)) << "k=" << kk;
+    }
+    const double ratio = polygon_area(xy, i * k, k) / area(s);
+    EXPECT_GT(ratio, 0.985) << "k=" << kk << " n=" << e.n;
+    EXPECT_LE(ratio, 1.0) << "k=" << kk << " n=" << e.n;
+    if (e.n == 2.0) {  // an affine image of the regular 24-gon
+      EXPECT_NEAR(ratio, 12.0 * std::sin(2.0 * std::numbers::pi / 24.0) / std::numbers::pi, 1e-5)
+          << "k=" << kk;
+    }
+  }
+}
+
+// A scene with shaped particles: every snapshot holds angle, semi_axis_a, semi_axis_b and
+// exponent, and /outlines/NNNNNN the particles' outline polygons, which snapshots.xmf shows
+// as an "outlines" grid (checked by tests/io/check_xdmf.py: every DataItem, the polygons'
+// areas and centres against the datasets); a disc-only store writes none of it. Through a
+// failed write (its staged outlines removed) and a resume (the outlines of the dropped
+// snapshots removed, the kept ones listed again).
+TEST(SnapshotWriter, ShapedParticlesCarryTheirShapeAndOutlines) {
+  ScratchDir dir;
+  const auto check_xdmf = [&](const std::string& when, bool shaped) {
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (comm_rank() != 0) return;
+    const std::string log = dir / "check_xdmf.log";
+    const std::string command = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) +
+                                "/tests/io/check_xdmf.py' '" + (dir / "snapshots.xmf") + "' > '" +
+                                log + "' 2>&1";
+    EXPECT_EQ(std::system(command.c_str()), 0) << when << ":\n" << read_text(log);
+    const std::string xmf = read_text(dir / "snapshots.xmf");
+    EXPECT_EQ(count(xmf, "<Grid Name=\"outlines\""),
+              shaped ? count(xmf, "<Grid Name=\"particles\"") : 0);
+    EXPECT_EQ(count(xmf, "TopologyType=\"Polygon\" NumberOfElements=\"7\" NodesPerElement=\"24\""),
+              count(xmf, "<Grid Name=\"outlines\""));
+  };
+  const int n = 7;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_shaped(writer, n, 0, 0.1);
+    ParticleStore p;
+    fill_shaped(p, n, 1);
+    writer.fail_before_dataset_for_testing(1000);  // after the last dataset and the outlines
+    EXPECT_THROW(writer.write(p, 0.2, 100), IoError);
+    write_shaped(writer, n, 1, 0.2);
+    write_shaped(writer, n, 2, 0.3);
+  }
+  check_xdmf("after three snapshots and a failed write", true);
+  if (comm_rank() == 0) {
+    H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+    ASSERT_GE(file.id, 0);
+    EXPECT_EQ(group_members(file.id, "/outlines"),
+              (std::set<std::string>{"000000", "000001", "000002"}));
+    EXPECT_EQ(group_members(file.id, "/incomplete"), std::set<std::string>{});
+    for (int v = 0; v < 3; ++v) check_shaped_snapshot(file.id, "00000" + std::to_string(v), n, v);
+  }
+  {
+    const auto writer = SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 0.15, 1e-9);
+    write_shaped(*writer, n, 3, 0.4);
+  }
+  check_xdmf("after a resume and one more snapshot", true);
+  if (comm_rank() == 0) {
+    H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+    ASSERT_GE(file.id, 0);
+    EXPECT_EQ(group_members(file.id, "/outlines"), (std::set<std::string>{"000000", "000001"}));
+    check_shaped_snapshot(file.id, "000000", n, 0);
+    check_shaped_snapshot(file.id, "000001", n, 3);
+  }
+  {  // discs only: no outlines, no polygons
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1);
+  }
+  check_xdmf("discs only", false);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  EXPECT_EQ(H5Lexists(file.id, "/outlines", H5P_DEFAULT), 0);
+  EXPECT_EQ(group_members(file.id, "/xdmf"), std::set<std::string>{"polyvertex_5"});
+  EXPECT_EQ(group_members(file.id, "/snapshots/000000").count("semi_axis_a"), 0u);
+}
+
+// The snapshots of a shaped scene on any rank count hold what the serial run's hold: ellipses in
+// a drum at 6 rad/s (crossing sectors, migrating) stepped on all ranks (MpiDomain) and on rank 0
+// alone, each writing a snapshot every 500 steps; post/h5compare.py finds the two files
+// bit-identical, the outlines included (matched by id), and check_xdmf.py accepts both.
+TEST(SnapshotWriter, ShapedSnapshotsOnAnyRankCountAreTheSerialOnes) {
+  ScratchDir dir;
+  const Scene scene = testing_support::shaped_drum_scene(100, 0.6, 6.0, true);
+  DecompositionOptions opt;
+  opt.has_center = true;
+  opt.center = scene.drum.center;
+  opt.repartition_threshold = 1.05;
+  opt.repartition_gap = 2;
+  MpiDomain domain(MPI_COMM_WORLD, opt);
+  Simulation par(scene, &domain);
+  std::optional<Simulation> ser;
+  std::unique_ptr<SnapshotWriter> ser_writer;
+  if (comm_rank() == 0) {
+    fs::create_directories(dir / "serial");
+    ser.emplace(scene);
+    ser_writer = std::make_unique<SnapshotWriter>(MPI_COMM_SELF, dir / "serial", scene.materials);
+  }
+  fs::path par_dir = dir / "parallel";
+  if (comm_rank() == 0) fs::create_directories(par_dir);
+  MPI_Barrier(MPI_COMM_WORLD);
+  {
+    SnapshotWriter par_writer(MPI_COMM_WORLD, par_dir.string(), scene.materials);
+    for (int s = 0; s <= 2000; ++s) {
+      if (s > 0) {
+        par.step();
+        if (ser) ser->step();
+      }
+      if (s % 500 != 0) continue;
+      par_writer.write(par.particles(), par.time(), s);
+      if (ser_writer) ser_writer->write(ser->particles(), ser->time(), s);
+    }
+  }
+  ser_writer.reset();
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  const std::string log = dir / "compare.log";
+  const std::string py = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR);
+  const std::string compare = py + "/post/h5compare.py' '" + (dir / "serial/snapshots.h5") + "' '" +
+                              (par_dir / "snapshots.h5").string() + "' > '" + log + "' 2>&1";
+  EXPECT_EQ(std::system(compare.c_str()), 0) << read_text(log);
+  for (const std::string& d : {dir / "serial", par_dir.string()}) {
+    const std::string check =
+        py + "/tests/io/check_xdmf.py' '" + d + "/snapshots.xmf' > '" + log + "' 2>&1";
+    EXPECT_EQ(std::system(check.c_str()), 0) << read_text(log);
+  }
+  H5Closer file{H5Fopen((par_dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  EXPECT_EQ(group_members(file.id, "/outlines").size(), 5u);
 }
 
 TEST(ParallelFile, ErrorsNameTheFileAndTheObject) {
