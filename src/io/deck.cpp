@@ -889,19 +889,6 @@ class DeckParser {
     if (scene_.run.integrator != IntegratorKind::kVerlet)
       refuse("run.integrator", deck::choice_name(deck::kIntegrators, scene_.run.integrator),
              "run.integrator = \"verlet\"");
-    // The breaking material must be discs: a superellipse's fragments are not made.
-    const std::string& ore = scene_.breakage.material;
-    bool shaped_ore = false;
-    for (const ParticleSpec& p : scene_.particles) shaped_ore |= p.shaped() && p.material == ore;
-    for (const FillSpec& f : scene_.fills)
-      shaped_ore |= f.shape == ParticleShape::kSuperellipse && f.material == ore;
-    if (scene_.breakage.present && shaped_ore) {
-      const toml::node* node = root.at_path("breakage.material").node();
-      diag_.error_in(node != nullptr ? diag_.where(*node) : std::string(diag_.where(root)),
-                     fmt::format("breakage.material = \"{}\": superellipses of it ({}, {}) "
-                                 "cannot break; breakable ore must be discs (shape = \"disc\")",
-                                 ore, shape_key, at));
-    }
   }
 
   void check_ore(const toml::table& root) {

@@ -14,6 +14,7 @@
 #include "core/geometry/walls.hpp"
 #include "core/mill/breakage_laws.hpp"
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse_sizing.hpp"
 
 namespace dem2d {
 
@@ -133,8 +134,15 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
     std::vector<char>& remove = plan_.remove;
     for (const Broken& b : plan_.broken) {
       const std::size_t k = b.index;
-      parents.push_back(
-          {p.id[k], p.material[k], p.radius[k], b.energy, p.pos[k], p.vel[k], p.omega[k]});
+      Parent q{p.id[k], p.material[k], size_radius(p, k), b.energy, p.pos[k], p.vel[k],
+               p.omega[k]};
+      if (p.shaped()) {
+        const double a = (*p.semi_a())[k], sb = (*p.semi_b())[k], n = (*p.exponent())[k];
+        if (a != sb || n != 2.0)
+          q.shape = {a >= sb ? sb / a : a / sb, n,
+                     a >= sb ? p.theta[k] : p.theta[k] + 0.5 * std::numbers::pi};
+      }
+      parents.push_back(q);
       remove[k] = 2;
     }
     for (std::size_t k = 0; k < p.n_owned(); ++k)
@@ -329,8 +337,15 @@ double Grinding::bear(double time, const Parent& q, int n, std::int64_t first, c
                                      static_cast<std::uint64_t>(q.id), 1);
   BreakageRecord record{time, q.id, q.radius, q.energy, n, first, mass, q.energy / mass};
   const auto born = [&](std::int64_t fid, double r_f, Vec2 offset) {
-    p.add(fid, q.material, r_f, density, q.x + offset, q.v + q.omega * Vec2{-offset.y, offset.x},
-          q.omega);
+    const Vec2 v = q.v + q.omega * Vec2{-offset.y, offset.x};
+    if (q.shape) {
+      // A superellipse's fragments: its aspect and exponent, turned as it was.
+      const SuperEllipse e = superellipse_of_size(r_f, q.shape->aspect, q.shape->exponent);
+      p.add_shaped(fid, q.material, e.a, e.b, e.n, density, q.x + offset, v, q.omega,
+                   q.shape->angle);
+    } else {
+      p.add(fid, q.material, r_f, density, q.x + offset, v, q.omega);
+    }
     fragment_log_.push_back({time, q.id, fid, r_f, Disc::mass(r_f, density)});
   };
   if (b.fragments == FragmentLaw::kEqual) {

@@ -31,6 +31,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "core/base/scene.hpp"
@@ -163,12 +164,19 @@ class Grinding {
     double sieved_mass = 0.0;
     bool feed = false;
   };
+  // A broken superellipse's form: aspect b / a <= 1, exponent, the angle of its long axis.
+  struct ParentShape {
+    double aspect, exponent, angle;
+  };
+  // radius: the size radius (a superellipse's volume-equivalent radius); shape: a
+  // superellipse's other than a round one (a disc's fragments are discs).
   struct Parent {
     std::int64_t id;
     std::int32_t material;
     double radius, energy;
     Vec2 x, v;
     double omega;
+    std::optional<ParentShape> shape{};
   };
   void collect_tests(const ParticleStore& p, const ContactEngine& contacts, bool evaluated,
                      std::vector<Test>& out);
