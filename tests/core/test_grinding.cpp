@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numbers>
 
@@ -171,12 +171,18 @@ TEST(Grinding, ABrokenSuperellipseGivesFragmentsOfItsFormAndMass) {
           if (norm(p.pos[a] - p.pos[b]) > p.radius[a] + p.radius[b]) continue;
           const SuperEllipse ea{(*p.semi_a())[a], (*p.semi_b())[a], (*p.exponent())[a]};
           const SuperEllipse eb{(*p.semi_a())[b], (*p.semi_b())[b], (*p.exponent())[b]};
-          const SuperPairContact c = contact_pair(ea, {p.pos[a], p.theta[a]}, eb, {p.pos[b], p.theta[b]});
+          const SuperPairContact c =
+              contact_pair(ea, {p.pos[a], p.theta[a]}, eb, {p.pos[b], p.theta[b]});
           const auto key = std::make_pair(std::min(p.id[a], p.id[b]), std::max(p.id[a], p.id[b]));
           const auto it = last.find(key);
-          if ((key.first == 39 && key.second == 43 && sim.time() > 0.0148) || (c.delta > 0 && it != last.end() && std::abs(c.delta - it->second) > 0.01 * ea.b))
-            std::printf("step %d t %.6f pair %lld %lld: delta %.5g -> %.5g conv %d it %d n (%.3f %.3f) th %.4f %.4f d %.4g\n", step, sim.time(),
-                        (long long)key.first, (long long)key.second, it->second, c.delta, c.converged, c.depth_iterations, c.n.x, c.n.y, p.theta[a], p.theta[b], norm(p.pos[a]-p.pos[b]));
+          if ((key.first == 39 && key.second == 43 && sim.time() > 0.0148) ||
+              (c.delta > 0 && it != last.end() && std::abs(c.delta - it->second) > 0.01 * ea.b))
+            std::printf(
+                "step %d t %.6f pair %lld %lld: delta %.5g -> %.5g conv %d it %d n (%.3f %.3f) th "
+                "%.4f %.4f d %.4g\n",
+                step, sim.time(), (long long)key.first, (long long)key.second, it->second, c.delta,
+                c.converged, c.depth_iterations, c.n.x, c.n.y, p.theta[a], p.theta[b],
+                norm(p.pos[a] - p.pos[b]));
           last[key] = c.delta;
         }
       if (sim.time() > 0.0152) break;

@@ -345,5 +345,45 @@ check "a run continued with --restart: the same snapshots and outlines as the wh
            '$py' '$source_dir/tests/io/check_xdmf.py' '$work/part/snapshots.xmf' &&
            test \$('$py' -c 'import h5py, sys; f = h5py.File(sys.argv[1]); print(len(f[\"outlines\"]) == len(f[\"snapshots\"]))' '$work/part/snapshots.h5') = True"
 
+# post/compare_shapes.py on two short runs of inputs/shapes.in's drum with a thinner charge
+# (discs, then ellipses of the same count and mass): its figures are the series' and the
+# snapshots' own means over the window, the reference's ratios are 1 and the masses agree.
+shapes_deck=$source_dir/inputs/shapes.in
+check "compare_shapes.py: discs against ellipses, figures recomputed from the runs" \
+  bash -c "'$dem2d' --quiet --output '$work/sd' --set run.duration=0.2 --set fill.0.bed_filling=0.1 --set output.snapshot_interval=0.02 '$shapes_deck' &&
+           '$dem2d' --quiet --output '$work/se' --set run.duration=0.2 --set fill.0.bed_filling=0.1 --set output.snapshot_interval=0.02 --set fill.0.shape=superellipse --set fill.0.aspect=0.5 '$shapes_deck' &&
+           '$py' '$post/compare_shapes.py' '$work/sd' '$work/se' --window 0.1 --json '$work/cmp.json' -o '$work/cmp.png' > '$work/cmp.txt' &&
+           test -s '$work/cmp.png' &&
+           '$py' - '$work/sd' '$work/se' '$work/cmp.json' <<'PY'
+import csv, json, sys
+import h5py
+import numpy as np
+runs = json.load(open(sys.argv[3]))
+assert runs[0]['label'] == 'discs', runs[0]['label']
+assert runs[1]['label'].startswith('superellipse n=2 aspect 0.5'), runs[1]['label']
+for folder, r in zip(sys.argv[1:3], runs):
+    rows = list(csv.DictReader(open(folder + '/series.csv')))
+    t = np.array([float(x['time']) for x in rows])
+    tail = t >= t[-1] - 0.1
+    sh = np.nanmean(np.array([float(x['shoulder_angle']) for x in rows])[tail])
+    pw = np.mean(np.array([float(x['drum_power']) for x in rows])[tail])
+    assert abs(sh - r['shoulder_angle_deg']) <= 1e-9 * abs(sh), (sh, r['shoulder_angle_deg'])
+    assert abs(pw - r['power_W']) <= 1e-9 * abs(pw) + 1e-12, (pw, r['power_W'])
+    f = h5py.File(folder + '/snapshots.h5', 'r')
+    v = []
+    for name in f['snapshots']:
+        g = f['snapshots'][name]
+        if g.attrs['time'] >= t[-1] - 0.1:
+            vel = np.asarray(g['velocity'][()]).reshape(-1, 2)
+            v.append(np.hypot(vel[:, 0], vel[:, 1]))
+    v = np.concatenate(v)
+    assert abs(v.mean() - r['speed_mean']) <= 1e-6 * v.mean(), (v.mean(), r['speed_mean'])
+assert abs(runs[0]['charge_mass_kg'] - runs[1]['charge_mass_kg']) <= 1e-12 * runs[0]['charge_mass_kg']
+assert runs[0]['particles'] == runs[1]['particles']
+text = open(sys.argv[3].replace('cmp.json', 'cmp.txt')).read()
+assert '( 1.00x)' in text.splitlines()[2], text
+print('compare_shapes figures recomputed')
+PY"
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -134,8 +134,7 @@ bool Grinding::apply(double time, ParticleStore& p, ContactEngine& contacts, Dom
     std::vector<char>& remove = plan_.remove;
     for (const Broken& b : plan_.broken) {
       const std::size_t k = b.index;
-      Parent q{p.id[k], p.material[k], size_radius(p, k), b.energy, p.pos[k], p.vel[k],
-               p.omega[k]};
+      Parent q{p.id[k], p.material[k], size_radius(p, k), b.energy, p.pos[k], p.vel[k], p.omega[k]};
       if (p.shaped()) {
         const double a = (*p.semi_a())[k], sb = (*p.semi_b())[k], n = (*p.exponent())[k];
         if (a != sb || n != 2.0)

@@ -1,0 +1,199 @@
+#!/usr/bin/python3
+"""Compare drum runs that differ in the particles' shape (inputs/shapes.in and its variants).
+
+    post/compare_shapes.py OUT_DISCS OUT_SQUARES OUT_ELLIPSES [--window 2] [-o shapes.png]
+                           [--json shapes.json]
+
+Each OUT is a dem2d output folder of the same drum with a charge of one shape; the first is the
+reference of the ratios. Over the last `window` seconds of each run (the second drum turn of a
+4 s run at 30 rpm) it reads:
+  - series.csv: the mean shoulder and toe angles (deg from the downward vertical, positive in
+    the drum's sense of rotation: how high the charge is carried) and the mean drive power (W
+    per slice);
+  - snapshots.h5: the particles' speeds in every snapshot of the window: mean, median, 90th
+    percentile and their histogram (the velocity distribution);
+  - lifters.csv, when the run wrote one: the normal load on the lifter bars against their angle,
+    folded onto one angle axis, its peak bin mean and the loaded window (bins above 10 % of it).
+It prints a table with each figure's ratio to the reference, writes the figures as JSON
+(--json), and draws the last snapshot of each run side by side with the speed histograms and
+the lifter loads (-o). Exit 1 when a folder lacks what it needs, 2 on bad arguments.
+"""
+
+import argparse
+import csv
+import json
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import millplot  # noqa: E402
+
+
+def label_of(run, folder):
+    """The run's shape as its deck and overrides say it ("discs", "superellipse n=8 aspect 1")."""
+    deck = millplot.deck_of(run)
+    fills = deck.get("fill", [])
+    f = fills[0] if fills else {}
+    if f.get("shape", "disc") != "superellipse":
+        return "discs"
+    return f"superellipse n={f.get('exponent', 2.0):g} aspect {f.get('aspect', 1.0):g}"
+
+
+def read_lifters(path, t0):
+    """lifters.csv rows from time t0 as (angle_deg, normal_N) arrays, or None without the file."""
+    if not os.path.exists(path):
+        return None
+    angle, normal = [], []
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            if float(row["time"]) >= t0:
+                angle.append(float(row["angle_deg"]))
+                normal.append(float(row["normal_N"]))
+    return np.asarray(angle), np.asarray(normal)
+
+
+def lifter_profile(angle, normal, bins=72):
+    """Mean normal load per angle bin (deg): bin centres, means, the peak mean and the loaded
+    window (first and last bin centre above 10 % of the peak)."""
+    edges = np.linspace(0.0, 360.0, bins + 1)
+    k = np.clip(np.digitize(angle % 360.0, edges) - 1, 0, bins - 1)
+    sums = np.bincount(k, weights=normal, minlength=bins)
+    counts = np.bincount(k, minlength=bins)
+    mean = np.divide(sums, counts, out=np.zeros(bins), where=counts > 0)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    peak = float(mean.max()) if len(mean) else 0.0
+    loaded = centres[mean > 0.1 * peak] if peak > 0 else np.array([])
+    window = [float(loaded.min()), float(loaded.max())] if len(loaded) else None
+    return centres, mean, peak, window
+
+
+def measure(folder, window):
+    """The figures of one run (see the module's docstring)."""
+    run = millplot.read_run_json(folder)
+    series_path = os.path.join(folder, "series.csv")
+    snaps_path = os.path.join(folder, "snapshots.h5")
+    for path in (series_path, snaps_path):
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"{path} is missing")
+    s = millplot.read_series(series_path)
+    t = s["time"]
+    t0 = t[-1] - window
+    tail = t >= t0
+    out = {"folder": folder, "label": label_of(run, folder), "window_s": [float(t0), float(t[-1])],
+           "charge_mass_kg": run.get("charge_mass_kg"), "particles": int(s["particles"][-1]),
+           "shoulder_angle_deg": float(np.nanmean(s["shoulder_angle"][tail])),
+           "toe_angle_deg": float(np.nanmean(s["toe_angle"][tail])),
+           "power_W": float(np.mean(s["drum_power"][tail]))}
+    import h5py
+    speeds, last = [], None
+    with h5py.File(snaps_path, "r") as f:
+        for name in millplot.list_snapshots(f):
+            snap = millplot.read_snapshot(f, name)
+            if snap["time"] >= t0:
+                speeds.append(snap["speed"])
+                last = (snap, millplot.read_outline(f, name))
+    if not speeds:
+        raise ValueError(f"{snaps_path} holds no snapshot in the last {window} s")
+    v = np.concatenate(speeds)
+    out.update({"speed_mean": float(v.mean()), "speed_median": float(np.median(v)),
+                "speed_p90": float(np.percentile(v, 90.0)), "snapshots": len(speeds)})
+    lifters = read_lifters(os.path.join(folder, "lifters.csv"), t0)
+    if lifters is not None and len(lifters[0]):
+        centres, mean, peak, loaded = lifter_profile(*lifters)
+        out.update({"lifter_peak_normal_N": peak, "lifter_loaded_window_deg": loaded})
+        out["_lifter_profile"] = (centres, mean)
+    out["_speeds"] = v
+    out["_last"] = last
+    out["_deck"] = millplot.deck_of(run)
+    return out
+
+
+FIGURES = [("shoulder_angle_deg", "shoulder angle [deg]"), ("toe_angle_deg", "toe angle [deg]"),
+           ("power_W", "drive power [W]"), ("speed_mean", "mean speed [m/s]"),
+           ("speed_median", "median speed [m/s]"), ("speed_p90", "90th pct speed [m/s]"),
+           ("lifter_peak_normal_N", "lifter peak normal load [N]")]
+
+
+def table(runs):
+    ref = runs[0]
+    lines = [f"{'':28s}" + "".join(f"{r['label'][:26]:>28s}" for r in runs)]
+    lines.append(f"{'charge mass [kg]':28s}" +
+                 "".join(f"{r['charge_mass_kg'] or float('nan'):>28.4g}" for r in runs))
+    for key, name in FIGURES:
+        if key not in ref:
+            continue
+        cells = []
+        for r in runs:
+            value = r.get(key, float("nan"))
+            ratio = value / ref[key] if ref[key] else float("nan")
+            cells.append(f"{value:>14.4g} ({ratio:5.2f}x)")
+        lines.append(f"{name:28s}" + "".join(f"{c:>28s}" for c in cells))
+    if "lifter_loaded_window_deg" in ref:
+        lines.append(f"{'lifter loaded [deg]':28s}" + "".join(
+            f"{'%.0f-%.0f' % tuple(r['lifter_loaded_window_deg']) if r.get('lifter_loaded_window_deg') else '-':>28s}"
+            for r in runs))
+    return "\n".join(lines)
+
+
+def draw(runs, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    n = len(runs)
+    has_lifters = all("_lifter_profile" in r for r in runs)
+    fig, axes = plt.subplots(2, n + (1 if has_lifters else 0), figsize=(4.2 * (n + has_lifters), 8.4),
+                             squeeze=False)
+    vmax = max(float(np.percentile(r["_speeds"], 99.0)) for r in runs)
+    for k, r in enumerate(runs):
+        snap, outline = r["_last"]
+        millplot.draw_charge(axes[0][k], snap, outline, r["_deck"], vmax)
+        axes[0][k].set_title(f"{r['label']}\nt = {snap['time']:.2f} s")
+        axes[1][k].hist(r["_speeds"], bins=40, range=(0.0, vmax), density=True, color="tab:blue")
+        axes[1][k].set_xlabel("speed [m/s]")
+        axes[1][k].set_ylabel("probability density [s/m]")
+        axes[1][k].set_title(f"mean {r['speed_mean']:.3f} m/s")
+    if has_lifters:
+        ax = axes[0][n]
+        for r in runs:
+            centres, mean = r["_lifter_profile"]
+            ax.plot(centres, mean, label=r["label"])
+        ax.set_xlabel("lifter angle from the bottom [deg]")
+        ax.set_ylabel("mean normal load [N]")
+        ax.legend(fontsize=8)
+        axes[1][n].axis("off")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("folders", nargs="+", help="dem2d output folders; the first is the reference")
+    parser.add_argument("--window", type=float, default=2.0, help="the last seconds compared [2]")
+    parser.add_argument("-o", "--output", help="draw the comparison to this PNG")
+    parser.add_argument("--json", help="write the figures to this JSON file")
+    args = parser.parse_args(argv)
+    if not args.window > 0.0:
+        parser.error("--window must be > 0")
+    try:
+        runs = [measure(folder, args.window) for folder in args.folders]
+    except (OSError, ValueError, KeyError) as e:
+        print(f"compare_shapes.py: {e}", file=sys.stderr)
+        return 1
+    print(table(runs))
+    masses = [r["charge_mass_kg"] for r in runs if r["charge_mass_kg"]]
+    if masses and max(masses) - min(masses) > 1e-9 * max(masses):
+        print("note: the charges' masses differ: " + ", ".join(f"{m:.6g}" for m in masses))
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump([{k: v for k, v in r.items() if not k.startswith("_")} for r in runs], f,
+                      indent=1)
+    if args.output:
+        draw(runs, args.output)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
