@@ -174,6 +174,7 @@ struct SuperPairContact {
   double rho_i = 0.0, rho_j = 0.0;  // curvature radii at p_i and p_j (capped)
   bool midway_converged = false;    // the midway point converged (else midway: its last iterate)
   int depth_iterations = 0;         // evaluations of the penetration depth's 1D minimisation
+  double angle = 0.0;               // the normal's lab angle: n = (cos, sin) of it
 };
 
 // Two superellipses. `warm`: the midway point of an earlier step (nullptr: a cold start). tol: on
@@ -183,5 +184,23 @@ struct SuperPairContact {
 SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                               const SuperPose& pj, const Vec2* warm = nullptr,
                               const SolveOptions& opt = {});
+
+// The penetration depth alone, without the midway point: the force kernel's solve. `start.warm`:
+// start from the lab angle start.phi (the normal of a nearby pose, such as the same contact's
+// last step: 2-3 evaluations), else from the coarse search of the cold start (contact_pair's
+// directions, taken from the line of centres outwards). start.bound_i, bound_j: the bounding
+// radii if known (0: computed here). The search stops at the first separating axis it meets
+// (along the line of centres, one of the coarse directions, or an iterate of the minimisation):
+// apart, with delta < 0 the gap along that axis (not the distance) and n along it, converged.
+// Overlapping bodies get contact_pair's contact (to the tolerance: its start may differ by
+// rounding). The midway fields are left unset.
+struct DepthStart {
+  bool warm = false;
+  double phi = 0.0;
+  double bound_i = 0.0, bound_j = 0.0;
+};
+SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
+                               const SuperPose& pj, const DepthStart& start = {},
+                               const SolveOptions& opt = {});
 
 }  // namespace dem2d
