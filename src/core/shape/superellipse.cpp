@@ -532,13 +532,15 @@ double cold_direction(const Body& bi, const Body& bj, Vec2 dn) {
 // pairs of a charge whose bounding circles overlap do not touch). For n > 2 the support
 // functions' bound |a u_x| + |b u_y| (no pow) is tried first along each. Apart: the gap along
 // that axis (negative); else the least overlap's direction (ties to the smaller |k|, then k > 0).
+// For n > 2 the two face normals facing the other body are tried before those directions
+// (`faces`); `search` false: the face normals alone (not apart: phi_dn, not a start).
 struct ColdStart {
   bool apart;
   double phi;
   Vec2 u;
   double overlap;
 };
-ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn) {
+ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, bool faces, bool search) {
   const double phi_dn = std::atan2(dn.y, dn.x);
   const double turn = 2.0 * std::numbers::pi / kColdDirections;
   const Vec2 step{std::cos(turn), std::sin(turn)}, back{step.x, -step.y};
@@ -547,9 +549,31 @@ ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn) {
   const auto bound = [](const SuperEllipse& s, Vec2 u) {
     return std::abs(s.a * u.x) + std::abs(s.b * u.y);
   };
+  const auto apart_along = [&](Vec2 u, double& gap) {
+    const Vec2 ui = to_body(u, bi.cs), uj = to_body(-u, bj.cs);
+    const double along = dot(u, d);
+    if (!ellipses) {
+      gap = bound(*bi.s, ui) + bound(*bj.s, uj) - along;
+      if (gap < 0.0) return true;
+    }
+    gap = dot(support(*bi.s, ui), ui) + dot(support(*bj.s, uj), uj) - along;
+    return gap < 0.0;
+  };
+  // The face normals facing the other body: for flat-sided bodies (n > 2) the likeliest
+  // separating axes (the separating axis of two rectangles is one of their face normals).
+  if (faces && !ellipses)
+    for (const Body* b : {&bi, &bj}) {
+      const Vec2 toward = b == &bi ? dn : -dn;
+      const Vec2 e = b->cs, f = perp(b->cs);
+      const double ce = dot(e, toward), cf = dot(f, toward);
+      Vec2 u = std::abs(ce) >= std::abs(cf) ? (ce >= 0.0 ? e : -e) : (cf >= 0.0 ? f : -f);
+      if (b == &bj) u = -u;
+      double gap = 0.0;
+      if (apart_along(u, gap)) return {true, std::atan2(u.y, u.x), u, gap};
+    }
   ColdStart best{false, phi_dn, dn, 0.0};
   Vec2 fwd = dn, bwd = dn;
-  for (int m = 0; m < kColdDirections; ++m) {
+  for (int m = 0; search && m < kColdDirections; ++m) {
     int k = 0;
     Vec2 u = dn;
     if (m % 2 == 1) {
@@ -562,14 +586,8 @@ ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn) {
       u = bwd;
     }
     const double phi = phi_dn + turn * k;
-    const Vec2 ui = to_body(u, bi.cs), uj = to_body(-u, bj.cs);
-    const double along = dot(u, d);
-    if (!ellipses) {
-      const double upper = bound(*bi.s, ui) + bound(*bj.s, uj) - along;
-      if (upper < 0.0) return {true, phi, u, upper};
-    }
-    const double overlap = dot(support(*bi.s, ui), ui) + dot(support(*bj.s, uj), uj) - along;
-    if (overlap < 0.0) return {true, phi, u, overlap};
+    double overlap = 0.0;
+    if (apart_along(u, overlap)) return {true, phi, u, overlap};
     if (m == 0 || overlap < best.overlap) best = {false, phi, u, overlap};
   }
   return best;
@@ -646,8 +664,11 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
   return r;
 }
 
-// Warm: the depth from the given angle. Cold: the coarse search from the line of centres
-// outwards, which ends at the first separating axis (apart) or starts the depth's minimisation.
+// Warm: the depth from the given angle. Cold: the face normals (n > 2), kApartProbe steps of the
+// minimisation from the line of centres, then the coarse search from the line of centres
+// outwards; each ends at the first separating axis (apart), else the search starts the depth's
+// minimisation.
+constexpr int kApartProbe = 4;
 SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                                const SuperPose& pj, const DepthStart& start,
                                const SolveOptions& opt) {
@@ -664,7 +685,29 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
   const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
   double phi0 = start.phi;
   if (!start.warm) {
-    const ColdStart cold = separating_or_cold(bi, bj, dn);
+    const ColdStart faces = separating_or_cold(bi, bj, dn, true, false);
+    if (faces.apart) {
+      r.delta = faces.overlap;
+      r.n = faces.u;
+      r.angle = faces.phi;
+      r.converged = true;
+      return r;
+    }
+    // A few steps of the minimisation from the line of centres first: most pairs apart show a
+    // negative overlap within them (the overlap falls towards the direction of closest approach).
+    SolveOptions few = opt;
+    few.max_iter = std::min(opt.max_iter, kApartProbe);
+    const double phi_dn = std::atan2(dn.y, dn.x);
+    const DepthSolve probe = solve_depth(bi, bj, phi_dn, std::numbers::pi / kColdDirections, few,
+                                         /*stop_apart=*/true);
+    if (probe.e.g < 0.0) {
+      r.delta = probe.e.g;
+      r.n = probe.e.u;
+      r.angle = probe.e.phi;
+      r.converged = true;
+      return r;
+    }
+    const ColdStart cold = separating_or_cold(bi, bj, dn, false, true);
     if (cold.apart) {
       r.delta = cold.overlap;
       r.n = cold.u;

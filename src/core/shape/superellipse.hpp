@@ -190,7 +190,8 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
 // last step: 2-3 evaluations), else from the coarse search of the cold start (contact_pair's
 // directions, taken from the line of centres outwards). start.bound_i, bound_j: the bounding
 // radii if known (0: computed here). The search stops at the first separating axis it meets
-// (along the line of centres, one of the coarse directions, or an iterate of the minimisation):
+// (for n > 2 the face normals facing the other body, then a few steps of the minimisation from
+// the line of centres, then the coarse directions, then the minimisation's iterates):
 // apart, with delta < 0 the gap along that axis (not the distance) and n along it, converged.
 // Overlapping bodies get contact_pair's contact (to the tolerance: its start may differ by
 // rounding). The midway fields are left unset.
