@@ -464,7 +464,10 @@ double newton_angle(const Body& bi, const Body& bj, const DepthEval& e, double r
   if (!(p > 1.0) || d == 0.0 || std::abs(d) > kFlatReach) return plain;
   const double sd = std::copysign(std::pow(std::abs(d), 1.0 / p), d);
   const double s1 = sd - e.dg / (e.ddg * p * d / sd);
-  return phi_a + std::copysign(std::min(std::pow(std::abs(s1), p), reach), s1);
+  const double back = p == std::floor(p) && p <= kMaxWholeExponent
+                          ? whole_power(std::abs(s1), static_cast<int>(p))
+                          : std::pow(std::abs(s1), p);
+  return phi_a + std::copysign(std::min(back, reach), s1);
 }
 
 // The penetration depth: the minimum of g over phi from phi0, by Newton on g' = 0 (newton_angle)
@@ -540,8 +543,8 @@ struct ColdStart {
   Vec2 u;
   double overlap;
 };
-ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, bool faces, bool search) {
-  const double phi_dn = std::atan2(dn.y, dn.x);
+ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, double phi_dn, bool faces,
+                             bool search) {
   const double turn = 2.0 * std::numbers::pi / kColdDirections;
   const Vec2 step{std::cos(turn), std::sin(turn)}, back{step.x, -step.y};
   const bool ellipses = bi.s->n == 2.0 && bj.s->n == 2.0;
@@ -566,10 +569,12 @@ ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, bool faces
       const Vec2 toward = b == &bi ? dn : -dn;
       const Vec2 e = b->cs, f = perp(b->cs);
       const double ce = dot(e, toward), cf = dot(f, toward);
-      Vec2 u = std::abs(ce) >= std::abs(cf) ? (ce >= 0.0 ? e : -e) : (cf >= 0.0 ? f : -f);
-      if (b == &bj) u = -u;
+      // The axis of the body's angle + quarter turns (0: e, 1: f, 2: -e, 3: -f), from i to j.
+      int quarter = std::abs(ce) >= std::abs(cf) ? (ce >= 0.0 ? 0 : 2) : (cf >= 0.0 ? 1 : 3);
+      Vec2 u = quarter == 0 ? e : quarter == 1 ? f : quarter == 2 ? -e : -f;
+      if (b == &bj) u = -u, quarter += 2;
       double gap = 0.0;
-      if (apart_along(u, gap)) return {true, std::atan2(u.y, u.x), u, gap};
+      if (apart_along(u, gap)) return {true, b->th + 0.5 * std::numbers::pi * quarter, u, gap};
     }
   ColdStart best{false, phi_dn, dn, 0.0};
   Vec2 fwd = dn, bwd = dn;
@@ -685,7 +690,8 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
   const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
   double phi0 = start.phi;
   if (!start.warm) {
-    const ColdStart faces = separating_or_cold(bi, bj, dn, true, false);
+    const double phi_dn = std::atan2(dn.y, dn.x);
+    const ColdStart faces = separating_or_cold(bi, bj, dn, phi_dn, true, false);
     if (faces.apart) {
       r.delta = faces.overlap;
       r.n = faces.u;
@@ -697,7 +703,6 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
     // negative overlap within them (the overlap falls towards the direction of closest approach).
     SolveOptions few = opt;
     few.max_iter = std::min(opt.max_iter, kApartProbe);
-    const double phi_dn = std::atan2(dn.y, dn.x);
     const DepthSolve probe = solve_depth(bi, bj, phi_dn, std::numbers::pi / kColdDirections, few,
                                          /*stop_apart=*/true);
     if (probe.e.g < 0.0) {
@@ -707,7 +712,7 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
       r.converged = true;
       return r;
     }
-    const ColdStart cold = separating_or_cold(bi, bj, dn, false, true);
+    const ColdStart cold = separating_or_cold(bi, bj, dn, phi_dn, false, true);
     if (cold.apart) {
       r.delta = cold.overlap;
       r.n = cold.u;
