@@ -148,11 +148,13 @@ SuperWallContact contact_point(const SuperEllipse& s, Vec2 centre, double theta,
 // meet near-parallel: the support points slide along a face for a tiny turn of the normal.
 //
 // The midway point X (F_i(X) = F_j(X), grad F_i(X) + mu^2 grad F_j(X) = 0: where the level sets
-// F_i = F_j = c first touch as c grows) is solved as well, as the warm start carried from step to
-// step (cold: from the depth's support points). Its own normal grad F_i(X) and the overlap along
-// it are not the contact's: the level sets F = c are not parallel to the curve, so they differ from
-// the penetration depth's at first order in the overlap (over the test's poses, overlaps 0.1-5 %
-// of the size: median 3e-4 rad and 4e-4 of the overlap, up to 6e-2 rad and 5e-2).
+// F_i = F_j = c first touch as c grows) is solved as well by contact_pair, as a warm start a caller
+// can carry from step to step (cold: from the depth's support points); the force kernel carries
+// the depth's own normal instead (contact_depth, below), which needs no midway solve. The
+// midway point's normal grad F_i(X) and the overlap along it are not the contact's: the level sets
+// F = c are not parallel to the curve, so they differ from the penetration depth's at first order
+// in the overlap (over the test's poses, overlaps 0.1-5 % of the size: median 3e-4 rad and 4e-4 of
+// the overlap, up to 6e-2 rad and 5e-2).
 
 // One body's place: centre of mass and angle (lab frame).
 struct SuperPose {
