@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <numbers>
@@ -200,6 +201,7 @@ int main(int argc, char** argv) {
     return usage();
   }
   using dem2d::SuperEllipseShape;
+  std::filesystem::create_directories(o.results);
 
   std::vector<Drum> drums;
   for (const Form& f : kForms) {
