@@ -209,7 +209,7 @@ void expect_round_superellipses_are_discs(RollingModelKind rolling) {
   std::printf(
       "round superellipses: vs the midway disc |dF|/F %.3g, |dT|/T %.3g; vs the disc's "
       "kernel |dF|/F %.3g, |dT|/T %.3g; %d pair steps, %d floor steps; %lld pair solves "
-      "(%lld unconverged, %.2f Newton steps each), %lld wall solves\n",
+      "(%lld unconverged, %.2f depth evaluations each), %lld wall solves\n",
       same.rel_force(), same.rel_torque(), disc_gap.rel_force(), disc_gap.rel_torque(), pair_steps,
       wall_steps, static_cast<long long>(st.pair_solves),
       static_cast<long long>(st.pair_unconverged),
@@ -406,7 +406,7 @@ TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictio
   const double m = p.mass[0], scale = m * 0.05 * 1.0 + 30.0 / p.inv_inertia[0];
   std::printf(
       "frictional impact: %d steps in contact, dp/(m) = %.3g %.3g, dL/scale = %.3g, "
-      "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f Newton steps each)\n",
+      "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f depth evaluations each)\n",
       in_contact, (momentum(p).x - p0.x) / m, (momentum(p).y - p0.y) / m,
       (angular_momentum(p) - l0) / scale, kinetic(sim) / e0,
       static_cast<long long>(SuperEllipseShape::stats().pair_solves),
