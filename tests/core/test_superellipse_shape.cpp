@@ -1,6 +1,6 @@
 // The superellipse as a particle shape of the force kernel (core/shape/superellipse_shape.hpp):
 //   - a = b, n = 2 superellipses give the disc kernel's forces and torques, step by step, for an
-//     oblique spinning pair rolling onto a floor (the general path with the midway-point solve);
+//     oblique spinning pair rolling onto a floor (the general path with the depth solve);
 //   - an elastic ellipse bouncing in a box of four segments keeps its kinetic + rotational energy
 //     over many impacts; two ellipses through a frictional impact keep momentum and angular
 //     momentum to rounding;
@@ -11,7 +11,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <numbers>
 #include <vector>
 
@@ -21,7 +20,6 @@
 #include "core/shape/superellipse_shape.hpp"
 #include "core/step/energy_ledger.hpp"
 #include "support/scenes.hpp"
-#include "support/thesis.hpp"
 
 namespace dem2d {
 namespace {
@@ -173,7 +171,7 @@ struct Gap {
 
 // An oblique collision of two spinning balls, the lower one sliding and spinning onto the floor
 // (test_shape_slot.cpp's scene). Round superellipses against (1) the disc through the general
-// path with the superellipse's arm convention: the same forces and torques to the midway solve's
+// path with the superellipse's arm convention: the same forces and torques to the solve's
 // tolerance; (2) the disc's own kernel, whose pair arms end at each body's own surface (r n, not
 // the common contact point (r - delta/2) n): apart by O(delta / r).
 template <class Law, class Rolling>
@@ -211,7 +209,7 @@ void expect_round_superellipses_are_discs(RollingModelKind rolling) {
   std::printf(
       "round superellipses: vs the midway disc |dF|/F %.3g, |dT|/T %.3g; vs the disc's "
       "kernel |dF|/F %.3g, |dT|/T %.3g; %d pair steps, %d floor steps; %lld pair solves "
-      "(%lld unconverged, %.2f Newton steps each), %lld wall solves\n",
+      "(%lld unconverged, %.2f depth evaluations each), %lld wall solves\n",
       same.rel_force(), same.rel_torque(), disc_gap.rel_force(), disc_gap.rel_torque(), pair_steps,
       wall_steps, static_cast<long long>(st.pair_solves),
       static_cast<long long>(st.pair_unconverged),
@@ -373,20 +371,21 @@ TEST(SuperEllipseShape, AnElasticEllipseInABoxKeepsItsEnergyOverManyImpacts) {
   EXPECT_EQ(SuperEllipseShape::stats().wall_unconverged, 0);
 }
 
-// With the true curvature radius at the contact point, R* changes as the ellipse turns during a
-// contact, and the Hertz force 4/3 E* sqrt(R*) delta^3/2 is then not the gradient of a potential:
-// the energy is kept only to a few 1e-3 (the same for dt = 2e-6, 1e-6 and 5e-7: the law's, not
-// the integration's).
-TEST(SuperEllipseShape, AnElasticEllipseInABoxWithItsCurvatureKeepsItsEnergyToTheLawsLimit) {
+// With the true curvature radius at the contact point, R* would change as the ellipse turns
+// during a contact, and the Hertz force 4/3 E* sqrt(R*) delta^3/2 would not be the gradient of a
+// potential (a drift of 4e-3 over 48 impacts in 1.5 s, the same for dt = 2e-6, 1e-6 and 5e-7).
+// The kernel freezes R* at the contact's first step: each contact is then conservative, and the
+// energy is kept as with a fixed R* (measured 1.9e-6 over 2 s).
+TEST(SuperEllipseShape, AnElasticEllipseInABoxWithItsCurvatureKeepsItsEnergy) {
   int impacts = 0;
   double spin_range = 0.0;
-  const double drift = box_energy_drift<SuperEllipseShape>(1.5, impacts, spin_range);
+  const double drift = box_energy_drift<SuperEllipseShape>(2.0, impacts, spin_range);
   std::printf(
-      "ellipse in a box, R* from the curvature: %d impacts in 1.5 s, max |E - E0| / E0 "
-      "%.3g\n",
+      "ellipse in a box, R* from the curvature at each contact's first step: %d impacts in 2 s, "
+      "max |E - E0| / E0 %.3g\n",
       impacts, drift);
   EXPECT_GE(impacts, 40);
-  EXPECT_LT(drift, 2e-2);
+  EXPECT_LT(drift, 5e-6);
 }
 
 TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictionalImpact) {
@@ -407,7 +406,7 @@ TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictio
   const double m = p.mass[0], scale = m * 0.05 * 1.0 + 30.0 / p.inv_inertia[0];
   std::printf(
       "frictional impact: %d steps in contact, dp/(m) = %.3g %.3g, dL/scale = %.3g, "
-      "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f Newton steps each)\n",
+      "E/E0 = %.4f, %lld pair solves (%lld unconverged, %.2f depth evaluations each)\n",
       in_contact, (momentum(p).x - p0.x) / m, (momentum(p).y - p0.y) / m,
       (angular_momentum(p) - l0) / scale, kinetic(sim) / e0,
       static_cast<long long>(SuperEllipseShape::stats().pair_solves),
@@ -427,7 +426,8 @@ TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictio
 // lasts (the contact rolls without slipping, so neither the dashpots nor friction take energy:
 // the mechanical energy stayed at 0.01191 J to 5 digits from 0.1 to 1.5 s); with the epsd model
 // and mu_r = 0.02 it comes to rest, within the small angle the rolling spring can hold
-// (mu_r R* F_n against m g times the contact point's offset, about 0.03 theta).
+// (mu_r R* F_n against m g times the contact point's offset, about 0.03 theta): R* is that of the
+// contact's first step (frozen), at most the flat side's a^2 / b = 0.04 m, so theta < 0.027 rad.
 TEST(SuperEllipseShape, ATiltedEllipseDroppedOnAFloorRestsOnItsFlatSide) {
   const double a = 0.02, b = 0.01;
   Scene s = scene_of(1e9, 0.3, 0.5, 0.02, 2e-6, {0.0, -9.81}, RollingModelKind::kEpsd);
@@ -443,7 +443,7 @@ TEST(SuperEllipseShape, ATiltedEllipseDroppedOnAFloorRestsOnItsFlatSide) {
       "%.2e rad, speed %.2e m/s, spin %.2e rad/s\n",
       sim.time(), p.pos[0].y, b, off, norm(p.vel[0]), p.omega[0]);
   EXPECT_NEAR(p.pos[0].y, b, 1e-3 * b);  // less its overlap under its weight (2e-6 m)
-  EXPECT_LT(off, 1e-2);
+  EXPECT_LT(off, 0.02 * (a * a / b) / (a * a / b - b));
   EXPECT_LT(norm(p.vel[0]), 1e-9);
   EXPECT_LT(std::abs(p.omega[0]), 1e-9);
 }
@@ -483,33 +483,6 @@ TEST(SuperEllipseShape, ARunOfEllipsesTwiceGivesTheSameBits) {
   }
   EXPECT_GT(one.neighbor_builds(), 1);
   EXPECT_GT(one.last_totals().contacts, 10) << "they settled into a heap";
-}
-
-// The cost per particle-step of ellipses (aspect 0.6) against discs of the same bounding radius
-// in the same drum scene (400 bodies, 1 rad/s), after 0.5 s of settling: processor time per
-// particle-step, a measurement run by
-// hand (--gtest_also_run_disabled_tests --gtest_filter=*Cost*).
-TEST(SuperEllipseShape, DISABLED_CostPerParticleStepInADrum) {
-  for (const bool shaped : {false, true}) {
-    const Scene s = testing_support::shaped_drum_scene(400, 0.6, 1.0, shaped);
-    Simulation sim(s);
-    while (sim.time() < 0.5) sim.step();
-    SuperEllipseShape::reset_stats();
-    const int steps = 20000;
-    // Processor time, not wall time: the machine may be shared.
-    const std::clock_t t0 = std::clock();
-    for (int n = 0; n < steps; ++n) sim.step();
-    const double sec = static_cast<double>(std::clock() - t0) / CLOCKS_PER_SEC;
-    const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
-    std::printf(
-        "%s: %.3g us per particle-step (%zu bodies, %lld contacts at the end; %.1f pair "
-        "and %.1f wall solves per step, %.2f Newton steps each, %lld unconverged)\n",
-        s.title.c_str(), 1e6 * sec / (steps * static_cast<double>(s.particles.size())),
-        s.particles.size(), static_cast<long long>(sim.last_totals().contacts),
-        static_cast<double>(st.pair_solves) / steps, static_cast<double>(st.wall_solves) / steps,
-        static_cast<double>(st.pair_iterations) / std::max<double>(1.0, st.pair_solves),
-        static_cast<long long>(st.pair_unconverged));
-  }
 }
 
 }  // namespace

@@ -629,7 +629,7 @@ TEST(Reproducibility, NoDrumPileFallingIntoABox) {
   expect_same_as_serial(s, 20000, 2000);
 }
 
-// Ellipses (the superellipse's kernel, its midway points kept as history) in a drum at 6 rad/s,
+// Ellipses (the superellipse's kernel, its normals and R* kept as history) in a drum at 6 rad/s,
 // crossing sectors: angles and shape fields ride with the ghosts and migrations.
 TEST(Reproducibility, EllipsesInADrum) {
   Scene s = testing_support::shaped_drum_scene(100, 0.6, 6.0, true);

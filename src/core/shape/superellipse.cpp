@@ -22,9 +22,21 @@ Vec2 to_lab(Vec2 v, Vec2 cs) { return rotate(v, cs); }
 struct AxisTerm {
   double f, g, h;
 };
+// u^k for a whole k >= 0 by repeated squaring (pow's value to a few ulps, a tenth of its time).
+double whole_power(double u, int k) {
+  double w = 1.0;
+  for (; k > 0; k >>= 1, u *= u)
+    if (k & 1) w *= u;
+  return w;
+}
+// A whole exponent up to this is taken by multiplication (n = 2: u^0 = 1, n = 4, n = 8, ...).
+constexpr double kMaxWholeExponent = 16.0;
 AxisTerm axis_term(double x, double a, double n) {
   const double u = std::min(std::abs(x) / a, kMaxScaled);
-  const double w = std::pow(u, n - 2.0);
+  const double e = n - 2.0;
+  const double w = e == std::floor(e) && e <= kMaxWholeExponent
+                       ? whole_power(u, static_cast<int>(e))
+                       : std::pow(u, e);
   const double u1 = w * u;
   return {u1 * u, std::copysign(n / a * u1, x), n * (n - 1.0) / (a * a) * w};
 }
@@ -72,6 +84,15 @@ NormValue body_norm(const SuperEllipse& s, Vec2 p) {
   return {v, (v / (s.n * f1)) * e.grad};
 }
 
+// x^(1/n) for x in [1, 2] (a support point's norm): square roots for n = 4 and 8, else pow.
+double root_n(double x, double n) {
+  if (n == 4.0) return std::sqrt(std::sqrt(x));
+  if (n == 8.0) return std::sqrt(std::sqrt(std::sqrt(x)));
+  return std::pow(x, 1.0 / n);
+}
+// x^q, q = 1 / (n - 1), for x in [0, 1]: the cube root for n = 4, else pow.
+double root_n1(double x, double n, double q) { return n == 4.0 ? std::cbrt(x) : std::pow(x, q); }
+
 }  // namespace
 
 // ---- Implicit function, support, curvature ------------------------------------------------------
@@ -92,10 +113,16 @@ Vec2 support(const SuperEllipse& s, Vec2 u) {
   const double by = s.b * std::abs(u.y);
   const double m = std::max(ax, by);
   if (!(m > 0.0)) return {s.a, 0.0};  // no direction given: any point will do
+  if (s.n == 2.0) {
+    // The ellipse: (a^2 u_x, b^2 u_y) / h, h = sqrt(a^2 u_x^2 + b^2 u_y^2) the support function.
+    const double h = std::sqrt(rounded(ax * ax) + rounded(by * by));
+    return {std::copysign(s.a * ax / h, u.x), std::copysign(s.b * by / h, u.y)};
+  }
   const double q = 1.0 / (s.n - 1.0);
-  const double sx = std::pow(ax / m, q);
-  const double sy = std::pow(by / m, q);
-  const double inv_norm = 1.0 / std::pow(sx * (ax / m) + sy * (by / m), 1.0 / s.n);
+  const double rx = ax / m, ry = by / m;  // one of them is 1
+  const double sx = rx < 1.0 ? root_n1(rx, s.n, q) : 1.0;
+  const double sy = ry < 1.0 ? root_n1(ry, s.n, q) : 1.0;
+  const double inv_norm = 1.0 / root_n(rounded(sx * rx) + rounded(sy * ry), s.n);
   return {std::copysign(s.a * sx * inv_norm, u.x), std::copysign(s.b * sy * inv_norm, u.y)};
 }
 
@@ -131,11 +158,21 @@ SupportCurvature support_curvature(const SuperEllipse& s, Vec2 u) {
   const double by = s.b * std::abs(u.y);
   const double m = std::max(ax, by);
   if (!(m > 0.0)) return {{s.a, 0.0}, curvature(s, {s.a, 0.0})};
+  if (s.n == 2.0) {
+    // The ellipse: support function h = sqrt(a^2 u_x^2 + b^2 u_y^2), point (a^2 u_x, b^2 u_y) / h,
+    // curvature radius h + h'' = a^2 b^2 / h^3.
+    const double h2 = rounded(ax * ax) + rounded(by * by);
+    const double h = std::sqrt(h2);
+    const double ab = s.a * s.b;
+    return {{std::copysign(s.a * ax / h, u.x), std::copysign(s.b * by / h, u.y)},
+            h2 * h / (ab * ab)};
+  }
   const double q = 1.0 / (s.n - 1.0);
-  const double rx = ax / m, ry = by / m;
-  const double sx = std::pow(rx, q), sy = std::pow(ry, q);
-  const double Nn = sx * rx + sy * ry;
-  const double N = std::pow(Nn, 1.0 / s.n);
+  const double rx = ax / m, ry = by / m;  // one of them is 1
+  const double sx = rx < 1.0 ? root_n1(rx, s.n, q) : 1.0;
+  const double sy = ry < 1.0 ? root_n1(ry, s.n, q) : 1.0;
+  const double Nn = rounded(sx * rx) + rounded(sy * ry);
+  const double N = root_n(Nn, s.n);
   const Vec2 p{std::copysign(s.a * sx / N, u.x), std::copysign(s.b * sy / N, u.y)};
   const double flat = s.n > 2.0 ? 0.0 : 1.0;
   const double wx = (sx > 0.0 ? rx / sx : flat) * N * N / Nn;  // X^(n-2)
@@ -143,7 +180,7 @@ SupportCurvature support_curvature(const SuperEllipse& s, Vec2 u) {
   // grad F = c (rx / a, ry / b), c = n / N^(n-1) = n N / N^n; F_xx = n (n-1) / a^2 X^(n-2).
   const double c = s.n * N / Nn;
   const double gx = rx / s.a, gy = ry / s.b;
-  const double g = std::hypot(gx, gy);
+  const double g = std::sqrt(rounded(gx * gx) + rounded(gy * gy));
   const double num = s.n * (s.n - 1.0) * (gy * gy * wx / (s.a * s.a) + gx * gx * wy / (s.b * s.b));
   return {p, num / (c * g * g * g)};
 }
@@ -295,11 +332,12 @@ SuperWallContact contact_inside_circle(const SuperEllipse& s, Vec2 centre, doubl
 
 namespace {
 
-// One body of a pair: its shape, centre and rotation (cos, sin).
+// One body of a pair: its shape, centre, rotation (cos, sin) and angle.
 struct Body {
   const SuperEllipse* s;
   Vec2 c;
   Vec2 cs;
+  double th = 0.0;
 };
 
 // F, its gradient and its Hessian (xx, xy, yy) at a lab-frame point.
@@ -419,14 +457,17 @@ double newton_angle(const Body& bi, const Body& bj, const DepthEval& e, double r
   const Body& b = e.kappa_i <= e.kappa_j ? bi : bj;
   const double p = b.s->n - 1.0;
   const double quarter = 0.5 * std::numbers::pi;
-  const double th = std::atan2(b.cs.y, b.cs.x);
+  const double th = b.th;
   const double phi_a = th + std::round((e.phi - th) / quarter) * quarter;
   const double d = e.phi - phi_a;
   const double plain = e.phi + std::clamp(-e.dg / e.ddg, -reach, reach);
   if (!(p > 1.0) || d == 0.0 || std::abs(d) > kFlatReach) return plain;
   const double sd = std::copysign(std::pow(std::abs(d), 1.0 / p), d);
   const double s1 = sd - e.dg / (e.ddg * p * d / sd);
-  return phi_a + std::copysign(std::min(std::pow(std::abs(s1), p), reach), s1);
+  const double back = p == std::floor(p) && p <= kMaxWholeExponent
+                          ? whole_power(std::abs(s1), static_cast<int>(p))
+                          : std::pow(std::abs(s1), p);
+  return phi_a + std::copysign(std::min(back, reach), s1);
 }
 
 // The penetration depth: the minimum of g over phi from phi0, by Newton on g' = 0 (newton_angle)
@@ -439,12 +480,16 @@ struct DepthSolve {
   bool converged;
 };
 DepthSolve solve_depth(const Body& bi, const Body& bj, double phi0, double reach,
-                       const SolveOptions& opt) {
+                       const SolveOptions& opt, bool stop_apart = false) {
   DepthSolve r{depth_at(bi, bj, phi0), 1, false};
   double lo = 0.0, hi = 0.0, last = 2.0 * reach;
   bool has_lo = false, has_hi = false;
   while (r.iterations < opt.max_iter) {
     const DepthEval& e = r.e;
+    if (stop_apart && e.g < 0.0) {  // a separating axis: apart, the gap along it
+      r.converged = true;
+      break;
+    }
     if (e.dg < 0.0) lo = e.phi, has_lo = true;
     if (e.dg > 0.0) hi = e.phi, has_hi = true;
     double next = newton_angle(bi, bj, e, reach);
@@ -467,16 +512,88 @@ DepthSolve solve_depth(const Body& bi, const Body& bj, double phi0, double reach
 // the penetration depth's basin where a start on the line of centres alone can miss it for
 // elongated bodies).
 constexpr int kColdDirections = 16;
+// The directions are dn turned by 2 pi k / kColdDirections, each from the last by one rotation
+// (rounding accumulates to a few ulps: the search only picks the start).
 double cold_direction(const Body& bi, const Body& bj, Vec2 dn) {
   const double phi_dn = std::atan2(dn.y, dn.x);
+  const double turn = 2.0 * std::numbers::pi / kColdDirections;
+  const Vec2 step{std::cos(turn), std::sin(turn)};
   double best = phi_dn, least = 0.0;
-  for (int k = 0; k < kColdDirections; ++k) {
-    const double phi = phi_dn + 2.0 * std::numbers::pi * k / kColdDirections;
-    const Vec2 u{std::cos(phi), std::sin(phi)};
+  Vec2 u = dn;
+  for (int k = 0; k < kColdDirections; ++k, u = rotate(u, step)) {
+    const double phi = phi_dn + turn * k;
     const Vec2 a = bi.c + to_lab(support(*bi.s, to_body(u, bi.cs)), bi.cs);
     const Vec2 b = bj.c + to_lab(support(*bj.s, to_body(-u, bj.cs)), bj.cs);
     const double overlap = dot(a - b, u);
     if (k == 0 || overlap < least) least = overlap, best = phi;
+  }
+  return best;
+}
+
+// The kernel's cold start: cold_direction's directions taken from dn outwards (k = 0, 1, -1, 2,
+// -2, ..., 8), stopping at the first along which the bodies are apart (a separating axis: most
+// pairs of a charge whose bounding circles overlap do not touch). For n > 2 the support
+// functions' bound |a u_x| + |b u_y| (no pow) is tried first along each. Apart: the gap along
+// that axis (negative); else the least overlap's direction (ties to the smaller |k|, then k > 0).
+// For n > 2 the two face normals facing the other body are tried before those directions
+// (`faces`); `search` false: the face normals alone (not apart: phi_dn, not a start).
+struct ColdStart {
+  bool apart;
+  double phi;
+  Vec2 u;
+  double overlap;
+};
+ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, double phi_dn, bool faces,
+                             bool search) {
+  const double turn = 2.0 * std::numbers::pi / kColdDirections;
+  const Vec2 step{std::cos(turn), std::sin(turn)}, back{step.x, -step.y};
+  const bool ellipses = bi.s->n == 2.0 && bj.s->n == 2.0;
+  const Vec2 d = bj.c - bi.c;
+  const auto bound = [](const SuperEllipse& s, Vec2 u) {
+    return std::abs(s.a * u.x) + std::abs(s.b * u.y);
+  };
+  const auto apart_along = [&](Vec2 u, double& gap) {
+    const Vec2 ui = to_body(u, bi.cs), uj = to_body(-u, bj.cs);
+    const double along = dot(u, d);
+    if (!ellipses) {
+      gap = bound(*bi.s, ui) + bound(*bj.s, uj) - along;
+      if (gap < 0.0) return true;
+    }
+    gap = dot(support(*bi.s, ui), ui) + dot(support(*bj.s, uj), uj) - along;
+    return gap < 0.0;
+  };
+  // The face normals facing the other body: for flat-sided bodies (n > 2) the likeliest
+  // separating axes (the separating axis of two rectangles is one of their face normals).
+  if (faces && !ellipses)
+    for (const Body* b : {&bi, &bj}) {
+      const Vec2 toward = b == &bi ? dn : -dn;
+      const Vec2 e = b->cs, f = perp(b->cs);
+      const double ce = dot(e, toward), cf = dot(f, toward);
+      // The axis of the body's angle + quarter turns (0: e, 1: f, 2: -e, 3: -f), from i to j.
+      int quarter = std::abs(ce) >= std::abs(cf) ? (ce >= 0.0 ? 0 : 2) : (cf >= 0.0 ? 1 : 3);
+      Vec2 u = quarter == 0 ? e : quarter == 1 ? f : quarter == 2 ? -e : -f;
+      if (b == &bj) u = -u, quarter += 2;
+      double gap = 0.0;
+      if (apart_along(u, gap)) return {true, b->th + 0.5 * std::numbers::pi * quarter, u, gap};
+    }
+  ColdStart best{false, phi_dn, dn, 0.0};
+  Vec2 fwd = dn, bwd = dn;
+  for (int m = 0; search && m < kColdDirections; ++m) {
+    int k = 0;
+    Vec2 u = dn;
+    if (m % 2 == 1) {
+      fwd = rotate(fwd, step);
+      k = (m + 1) / 2;
+      u = fwd;
+    } else if (m > 0) {
+      bwd = rotate(bwd, back);
+      k = -m / 2;
+      u = bwd;
+    }
+    const double phi = phi_dn + turn * k;
+    double overlap = 0.0;
+    if (apart_along(u, overlap)) return {true, phi, u, overlap};
+    if (m == 0 || overlap < best.overlap) best = {false, phi, u, overlap};
   }
   return best;
 }
@@ -526,8 +643,8 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
   r.delta = Ri + Rj - dist;
   if (r.delta <= 0.0) return r;  // the bounding circles are apart
   r.candidate = true;
-  const Body bi{&si, pi.centre, angle_cs(pi.theta)};
-  const Body bj{&sj, pj.centre, angle_cs(pj.theta)};
+  const Body bi{&si, pi.centre, angle_cs(pi.theta), pi.theta};
+  const Body bj{&sj, pj.centre, angle_cs(pj.theta), pj.theta};
   const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
   const double L = 0.5 * (Ri + Rj);
   const double tol2 = opt.tol * opt.tol;
@@ -552,6 +669,68 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
   return r;
 }
 
+// Warm: the depth from the given angle. Cold: the face normals (n > 2), kApartProbe steps of the
+// minimisation from the line of centres, then the coarse search from the line of centres
+// outwards; each ends at the first separating axis (apart), else the search starts the depth's
+// minimisation.
+constexpr int kApartProbe = 4;
+SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
+                               const SuperPose& pj, const DepthStart& start,
+                               const SolveOptions& opt) {
+  SuperPairContact r;
+  const Vec2 d = pj.centre - pi.centre;
+  const double dist = std::sqrt(rounded(d.x * d.x) + rounded(d.y * d.y));
+  const double Ri = start.bound_i > 0.0 ? start.bound_i : bounding_radius(si);
+  const double Rj = start.bound_j > 0.0 ? start.bound_j : bounding_radius(sj);
+  r.delta = Ri + Rj - dist;
+  if (r.delta <= 0.0) return r;  // the bounding circles are apart
+  r.candidate = true;
+  const Body bi{&si, pi.centre, angle_cs(pi.theta), pi.theta};
+  const Body bj{&sj, pj.centre, angle_cs(pj.theta), pj.theta};
+  const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
+  double phi0 = start.phi;
+  if (!start.warm) {
+    const double phi_dn = std::atan2(dn.y, dn.x);
+    const ColdStart faces = separating_or_cold(bi, bj, dn, phi_dn, true, false);
+    if (faces.apart) {
+      r.delta = faces.overlap;
+      r.n = faces.u;
+      r.angle = faces.phi;
+      r.converged = true;
+      return r;
+    }
+    // A few steps of the minimisation from the line of centres first: most pairs apart show a
+    // negative overlap within them (the overlap falls towards the direction of closest approach).
+    SolveOptions few = opt;
+    few.max_iter = std::min(opt.max_iter, kApartProbe);
+    const DepthSolve probe = solve_depth(bi, bj, phi_dn, std::numbers::pi / kColdDirections, few,
+                                         /*stop_apart=*/true);
+    if (probe.e.g < 0.0) {
+      r.delta = probe.e.g;
+      r.n = probe.e.u;
+      r.angle = probe.e.phi;
+      r.converged = true;
+      return r;
+    }
+    const ColdStart cold = separating_or_cold(bi, bj, dn, phi_dn, false, true);
+    if (cold.apart) {
+      r.delta = cold.overlap;
+      r.n = cold.u;
+      r.angle = cold.phi;
+      r.converged = true;
+      return r;
+    }
+    phi0 = cold.phi;
+  }
+  const DepthSolve depth =
+      solve_depth(bi, bj, phi0, std::numbers::pi / kColdDirections, opt, /*stop_apart=*/true);
+  r.depth_iterations = depth.iterations;
+  r.converged = depth.converged;
+  r.angle = depth.e.phi;
+  finish_pair(bi, bj, depth.e, r);
+  return r;
+}
+
 // ---- A segment (after the pair: its ends use the pair's 1D minimisation) ----------------------
 
 namespace {
@@ -562,8 +741,8 @@ namespace {
 // body of no size. Kept if its normal stays on e's side (u . t_out <= 0), else `face`.
 SuperWallContact past_an_end(const SuperEllipse& s, Vec2 centre, double theta, Vec2 e, Vec2 m,
                              Vec2 t_out, const SuperWallContact& face, const SolveOptions& opt) {
-  const Body body{&s, centre, angle_cs(theta)};
-  const Body end{nullptr, e, {1.0, 0.0}};
+  const Body body{&s, centre, angle_cs(theta), theta};
+  const Body end{nullptr, e, {1.0, 0.0}, 0.0};
   const double reach = 0.125 * std::numbers::pi;
   const DepthSolve d = solve_depth(body, end, std::atan2(-m.y, -m.x), reach, opt);
   if (!(dot(d.e.u, t_out) <= 0.0) || !(d.e.g < face.contact.g.delta)) {

@@ -148,11 +148,13 @@ SuperWallContact contact_point(const SuperEllipse& s, Vec2 centre, double theta,
 // meet near-parallel: the support points slide along a face for a tiny turn of the normal.
 //
 // The midway point X (F_i(X) = F_j(X), grad F_i(X) + mu^2 grad F_j(X) = 0: where the level sets
-// F_i = F_j = c first touch as c grows) is solved as well, as the warm start carried from step to
-// step (cold: from the depth's support points). Its own normal grad F_i(X) and the overlap along
-// it are not the contact's: the level sets F = c are not parallel to the curve, so they differ from
-// the penetration depth's at first order in the overlap (over the test's poses, overlaps 0.1-5 %
-// of the size: median 3e-4 rad and 4e-4 of the overlap, up to 6e-2 rad and 5e-2).
+// F_i = F_j = c first touch as c grows) is solved as well by contact_pair, as a warm start a caller
+// can carry from step to step (cold: from the depth's support points); the force kernel carries
+// the depth's own normal instead (contact_depth, below), which needs no midway solve. The
+// midway point's normal grad F_i(X) and the overlap along it are not the contact's: the level sets
+// F = c are not parallel to the curve, so they differ from the penetration depth's at first order
+// in the overlap (over the test's poses, overlaps 0.1-5 % of the size: median 3e-4 rad and 4e-4 of
+// the overlap, up to 6e-2 rad and 5e-2).
 
 // One body's place: centre of mass and angle (lab frame).
 struct SuperPose {
@@ -174,6 +176,7 @@ struct SuperPairContact {
   double rho_i = 0.0, rho_j = 0.0;  // curvature radii at p_i and p_j (capped)
   bool midway_converged = false;    // the midway point converged (else midway: its last iterate)
   int depth_iterations = 0;         // evaluations of the penetration depth's 1D minimisation
+  double angle = 0.0;               // the normal's lab angle: n = (cos, sin) of it
 };
 
 // Two superellipses. `warm`: the midway point of an earlier step (nullptr: a cold start). tol: on
@@ -183,5 +186,24 @@ struct SuperPairContact {
 SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                               const SuperPose& pj, const Vec2* warm = nullptr,
                               const SolveOptions& opt = {});
+
+// The penetration depth alone, without the midway point: the force kernel's solve. `start.warm`:
+// start from the lab angle start.phi (the normal of a nearby pose, such as the same contact's
+// last step: 2-3 evaluations), else from the coarse search of the cold start (contact_pair's
+// directions, taken from the line of centres outwards). start.bound_i, bound_j: the bounding
+// radii if known (0: computed here). The search stops at the first separating axis it meets
+// (for n > 2 the face normals facing the other body, then a few steps of the minimisation from
+// the line of centres, then the coarse directions, then the minimisation's iterates):
+// apart, with delta < 0 the gap along that axis (not the distance) and n along it, converged.
+// Overlapping bodies get contact_pair's contact (to the tolerance: its start may differ by
+// rounding). The midway fields are left unset.
+struct DepthStart {
+  bool warm = false;
+  double phi = 0.0;
+  double bound_i = 0.0, bound_j = 0.0;
+};
+SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
+                               const SuperPose& pj, const DepthStart& start = {},
+                               const SolveOptions& opt = {});
 
 }  // namespace dem2d
