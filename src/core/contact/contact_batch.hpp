@@ -89,13 +89,17 @@ struct ContactBatch : BatchColumns<ContactBatch> {
   Array<double> t_i, t_j;  // torques on i and on j
   Array<double> overlap;   // delta / min(r_i, r_j)
   Array<double> ex, ey;    // the elastic normal force on i (ContactForceT::f_el)
+  // Its torques on i and on j, for a shape whose arms leave the normal (else not written).
+  Array<double> et_i, et_j;
 
   std::array<Array<double>*, 16 + kMaxHistorySlots> inputs() {
     return with_history<16>({&dx, &dy, &dist2, &r_i, &r_j, &m_i, &m_j, &vx, &vy, &spin, &omega_rel,
                              &counted, &w_i, &w_j, &th_i, &th_j},
                             history);
   }
-  std::array<Array<double>*, 7> outputs() { return {&fx, &fy, &t_i, &t_j, &overlap, &ex, &ey}; }
+  std::array<Array<double>*, 9> outputs() {
+    return {&fx, &fy, &t_i, &t_j, &overlap, &ex, &ey, &et_i, &et_j};
+  }
 };
 
 // The particle-wall contacts of one force evaluation, in the same three phases: the geometry
@@ -116,14 +120,15 @@ struct WallBatch : BatchColumns<WallBatch> {
   Array<double> fx, fy, torque, m_roll;
   Array<double> diss_law, el_law, diss_roll, el_roll;
   Array<double> ex, ey;  // the elastic normal force (ContactForceT::f_el)
+  Array<double> et;      // its torque, for a shape whose arms leave the normal (else not written)
 
   std::array<Array<double>*, 11 + kMaxHistorySlots> inputs() {
     return with_history<11>({&delta, &nx, &ny, &r, &m, &vx, &vy, &omega_rel, &ax, &ay, &r_eff},
                             history);
   }
-  std::array<Array<double>*, 14> outputs() {
-    return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque,
-            &m_roll, &diss_law, &el_law, &diss_roll, &el_roll, &ex, &ey};
+  std::array<Array<double>*, 15> outputs() {
+    return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque, &m_roll,
+            &diss_law, &el_law, &diss_roll, &el_roll, &ex,     &ey, &et};
   }
 };
 

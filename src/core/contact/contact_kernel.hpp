@@ -211,6 +211,7 @@ class Kernel final : public ContactKernel {
   // What one pack of pairs hands to the batch (put_pack).
   struct PackOut {
     Pack fx, fy, ti, tj, diss, el, ratio, ex, ey;
+    Pack eti, etj;  // the elastic normal force's torques on i and j (arms apart; else unused)
   };
   void put_pack(std::size_t c, std::size_t n, const PackOut& o, EightLanes& dissipated,
                 EightLanes& elastic, Pack& overlap);
@@ -280,6 +281,9 @@ class Kernel final : public ContactKernel {
   };
   Array<std::uint8_t> touch_;
   Array<ForceRecord> records_;
+  // Beside them, for a shape whose arms leave the normal: the elastic normal force's torque on
+  // i (2k) and on j (2k + 1) (else never sized).
+  Array<double> elastic_torque_records_;
   bool prefetch_scatter_ = false;  // scatter_pairs fetches the partners' lines ahead
   // With kSemiAxes: each batch contact's a_i, b_i, n_i, a_j, b_j, n_j (else never sized).
   std::array<Array<double>, 6> forms_;

@@ -37,6 +37,7 @@ void Kernel<Model, Shape>::prepare_pairs([[maybe_unused]] ParticleStore& p, Pair
   if (!pl.canonical() && touch_.size() != pl.size()) {
     touch_.assign(pl.size(), 0);
     records_.resize(2 * pl.size());
+    if constexpr (kArmsApart) elastic_torque_records_.resize(2 * pl.size());
   }
 }
 
@@ -209,8 +210,10 @@ void Kernel<Model, Shape>::evaluate_pairs(std::size_t n, double dt, EightLanes& 
       Pack ratio = kin.delta / vmin(ri, rj);
       if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
         ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
-      put_pack(c, n, {fx, fy, ti, tj, diss, el, ratio, -cf.f_el * nx, -cf.f_el * ny}, dissipated,
-               elastic, overlap);
+      put_pack(c, n,
+               {fx, fy, ti, tj, diss, el, ratio, -cf.f_el * nx, -cf.f_el * ny, Pack(0.0),
+                Pack(0.0)},
+               dissipated, elastic, overlap);
     }
   }
 }
@@ -237,6 +240,10 @@ template <class Model, class Shape>
   store(o.ratio, b_.overlap, c);
   store(o.ex, b_.ex, c);
   store(o.ey, b_.ey, c);
+  if constexpr (kArmsApart) {
+    store(o.eti, b_.et_i, c);
+    store(o.etj, b_.et_j, c);
+  }
 }
 
 // B for a shape whose arms leave the normal: its narrow phase reads and advances its own history
@@ -293,8 +300,12 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
     Pack ratio = kin.delta / vmin(ri, rj);
     if constexpr (Model::Tracker::kExcludes) ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
     const Pack f_el = select(touching, cf.f_el, zero);
+    // The elastic normal force -f_el n on i, +f_el n on j, and its torques a x F.
+    const Pack eti = -f_el * (g.aix * ny - g.aiy * nx);
+    const Pack etj = f_el * (g.ajx * ny - g.ajy * nx);
     put_pack(c, n,
-             {fx, fy, ti, tj, diss, el, select(touching, ratio, zero), -f_el * nx, -f_el * ny},
+             {fx, fy, ti, tj, diss, el, select(touching, ratio, zero), -f_el * nx, -f_el * ny, eti,
+              etj},
              dissipated, elastic, overlap);
   }
 }
@@ -331,6 +342,11 @@ void Kernel<Model, Shape>::scatter_pairs(ParticleStore& p, PairList& pl, std::si
     const Vec2 ei{b_.ex[c], b_.ey[c]};
     f_el[i] += ei;
     f_el[j] -= ei;
+    if constexpr (kArmsApart) {
+      double* et = p.elastic_torque()->data();
+      et[i] += b_.et_i[c];
+      et[j] += b_.et_j[c];
+    }
     for (std::size_t s = 0; s < W; ++s)
       trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
   }
@@ -356,6 +372,10 @@ void Kernel<Model, Shape>::write_records(PairList& pl, std::size_t n) {
     const std::size_t k = static_cast<std::size_t>(b_.pair[c]);
     rec[2 * k] = {b_.fx[c], b_.fy[c], b_.t_i[c], b_.ex[c], b_.ey[c]};
     rec[2 * k + 1] = {-b_.fx[c], -b_.fy[c], b_.t_j[c], -b_.ex[c], -b_.ey[c]};
+    if constexpr (kArmsApart) {
+      elastic_torque_records_[2 * k] = b_.et_i[c];
+      elastic_torque_records_[2 * k + 1] = b_.et_j[c];
+    }
     for (std::size_t s = 0; s < W; ++s) trial[k * W + s] = b_.history.fresh[s][c];
   }
 }
@@ -387,6 +407,14 @@ void Kernel<Model, Shape>::sum_records(ParticleStore& p, const PairList& pl) {
     f[q] = fq;
     tq[q] = tq_q;
     f_el[q] = eq;
+  }
+  if constexpr (kArmsApart) {
+    double* et = p.elastic_torque()->data();
+    for (std::size_t q = 0; q < n_owned; ++q)
+      for (std::int32_t s = pl.record_start[q]; s < pl.record_start[q + 1]; ++s) {
+        const std::int32_t r = index[s];
+        if (touch[r >> 1] != 0) et[q] += elastic_torque_records_[static_cast<std::size_t>(r)];
+      }
   }
 }
 

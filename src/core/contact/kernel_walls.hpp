@@ -135,6 +135,8 @@ void Kernel<Model, Shape>::evaluate_walls(std::size_t n, double dt) {
     store(fx, wb_.fx, c);
     store(fy, wb_.fy, c);
     store(ti, wb_.torque, c);
+    if constexpr (kArmsApart)  // the elastic normal force -f_el n's torque
+      store(-cf.f_el * (load(wb_.ax, c) * ny - load(wb_.ay, c) * nx), wb_.et, c);
     store(out.rolling.torque, wb_.m_roll, c);
     store(cf.dissipated, wb_.diss_law, c);
     store(cf.elastic, wb_.el_law, c);
@@ -162,6 +164,7 @@ void Kernel<Model, Shape>::scatter_walls(ParticleStore& p, WallPairList& wl, std
     f[i] += fi;
     tq[i] += wb_.torque[c];
     f_el[i] += Vec2{wb_.ex[c], wb_.ey[c]};
+    if constexpr (kArmsApart) (*p.elastic_torque())[i] += wb_.et[c];
     dissipated += wb_.diss_law[c];
     elastic += wb_.el_law[c];
     if constexpr (Model::Rolling::kActive) {

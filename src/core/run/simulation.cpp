@@ -406,6 +406,8 @@ void Simulation::contact_forces(double dt, bool owned_cleared) {
     tq[k] = 0.0;
     e[k] = {};
   }
+  if (Field<double>* et = particles_.elastic_torque())
+    std::fill(et->data(), et->data() + particles_.size(), 0.0);
   contacts_.evaluate(particles_, walls_, dt);
 }
 

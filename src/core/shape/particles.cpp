@@ -49,6 +49,10 @@ void ParticleStore::enable_shape() {
   exponent_ = std::make_unique<Field<double>>(
       "exponent", registry_,
       FieldMeta{"1", "superellipse exponent n (2: an ellipse or a disc)", true, true});
+  elastic_torque_ = std::make_unique<Field<double>>(
+      "elastic_torque", registry_,
+      FieldMeta{"N m", "torque of the elastic normal part of `force` (superellipses)"});
+  elastic_torque_->resize(size());
   semi_a_->resize(size());
   semi_b_->resize(size());
   exponent_->resize(size());

@@ -163,6 +163,11 @@ class ParticleStore {
   const Field<double>* semi_b() const { return semi_b_.get(); }
   Field<double>* exponent() { return exponent_.get(); }
   const Field<double>* exponent() const { return exponent_.get(); }
+  // With the shape fields: the torque of the elastic normal part of `force` (a superellipse's
+  // contact arm leaves its normal, so that force turns it; a disc's passes through its centre).
+  // The energy ledger leaves its work out of the dissipated energy, as it does the force's.
+  Field<double>* elastic_torque() { return elastic_torque_.get(); }
+  const Field<double>* elastic_torque() const { return elastic_torque_.get(); }
   bool shaped() const { return semi_a_ != nullptr; }
   void enable_shape();
 
@@ -199,7 +204,7 @@ class ParticleStore {
   std::uint64_t layout_ = 0;
   std::unique_ptr<Field<double>> damage_;
   std::unique_ptr<Field<double>> last_contact_;
-  std::unique_ptr<Field<double>> semi_a_, semi_b_, exponent_;
+  std::unique_ptr<Field<double>> semi_a_, semi_b_, exponent_, elastic_torque_;
 };
 
 // The radius that sizes particle k (its sieve size is twice it): a disc's radius, a

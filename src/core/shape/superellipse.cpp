@@ -3,6 +3,7 @@
 #include "core/shape/superellipse.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -674,6 +675,39 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
 // outwards; each ends at the first separating axis (apart), else the search starts the depth's
 // minimisation.
 constexpr int kApartProbe = 4;
+namespace {
+
+// A deep overlap (beyond kDeepOverlap of the thinner body's smallest semi-axis: fragments born
+// inside each other, never a contact of a mill's charge) can have several local minima of the
+// overlap over the normal's angle; a solve started near one stays in it, and when that minimum
+// vanishes the overlap jumps. There the smallest of all local minima is taken: those of
+// kDeepDirections evenly spaced directions, each refined, the lowest kept (with `depth`, the
+// solve's own). The global minimum moves continuously with the bodies.
+constexpr double kDeepOverlap = 0.1;
+constexpr int kDeepDirections = 64;
+
+void deepest_minimum(const Body& bi, const Body& bj, const SolveOptions& opt, DepthSolve& depth) {
+  std::array<double, kDeepDirections> g{};
+  for (int k = 0; k < kDeepDirections; ++k)
+    g[static_cast<std::size_t>(k)] =
+        depth_at(bi, bj, 2.0 * std::numbers::pi * k / kDeepDirections).g;
+  for (int k = 0; k < kDeepDirections; ++k) {
+    const double here = g[static_cast<std::size_t>(k)];
+    const double before = g[static_cast<std::size_t>((k + kDeepDirections - 1) % kDeepDirections)];
+    const double after = g[static_cast<std::size_t>((k + 1) % kDeepDirections)];
+    if (!(here <= before && here <= after)) continue;
+    const DepthSolve local = solve_depth(bi, bj, 2.0 * std::numbers::pi * k / kDeepDirections,
+                                         std::numbers::pi / kDeepDirections, opt, false);
+    if (local.e.g < depth.e.g) {
+      const int spent = depth.iterations;
+      depth = local;
+      depth.iterations += spent;
+    }
+  }
+}
+
+}  // namespace
+
 SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                                const SuperPose& pj, const DepthStart& start,
                                const SolveOptions& opt) {
@@ -722,8 +756,10 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
     }
     phi0 = cold.phi;
   }
-  const DepthSolve depth =
+  DepthSolve depth =
       solve_depth(bi, bj, phi0, std::numbers::pi / kColdDirections, opt, /*stop_apart=*/true);
+  const double thinnest = std::min(std::min(si.a, si.b), std::min(sj.a, sj.b));
+  if (depth.e.g > kDeepOverlap * thinnest) deepest_minimum(bi, bj, opt, depth);
   r.depth_iterations = depth.iterations;
   r.converged = depth.converged;
   r.angle = depth.e.phi;

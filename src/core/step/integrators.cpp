@@ -89,9 +89,15 @@ StepOutcome VelocityVerlet::close_step(StepStages& s, bool rebuilt) {
   const bool population_changes = s.population_changes();
   const Vec2* x_build = s.rebuilds().positions_at_build();
   ahead_ = run_ahead_allowed_ && !rebuilt && !population_changes;
-  const ClosingKick closing = ahead_
-                                  ? closing_kick_drift(p, x_build, dt_, gravity_, s.drift_mirror())
-                                  : closing_kick(p, x_build, dt_, gravity_);
+  ClosingKick closing = ahead_ ? closing_kick_drift(p, x_build, dt_, gravity_, s.drift_mirror())
+                               : closing_kick(p, x_build, dt_, gravity_);
+  // The closing kick booked the late work of the whole torque; a superellipse's elastic normal
+  // force has a torque too, whose work is the elastic energy's (not dissipated): taken back.
+  if (const Field<double>* et = p.elastic_torque()) {
+    double late = 0.0;
+    for (std::size_t k = 0; k < p.n_owned(); ++k) late += (*et)[k] * (0.5 * dt_ * p.alpha[k]);
+    closing.late_loss += dt_ * late;
+  }
   s.commit(dt_, closing.late_loss);
   passes_.add(1);
   return end_of_step_round(s, closing, s.totals().max_overlap);
