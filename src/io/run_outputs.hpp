@@ -6,7 +6,9 @@
 
 #include <memory>
 
+#include "core/geometry/lifter_loads.hpp"
 #include "core/run/simulation.hpp"
+#include "io/lifter_log.hpp"
 #include "io/ore_logs.hpp"
 #include "io/series.hpp"
 
@@ -33,6 +35,21 @@ class OreOutput {
 
  private:
   std::unique_ptr<OreLogs> logs_;
+};
+
+// lifters.csv of drum scenes with lifter bars (nothing for other scenes): at a series row, the
+// last force evaluation's records on the bars, resolved on their ranks, gathered (6 words per
+// record) and summed per bar in (particle id, element) order, the same bits on any rank count;
+// rank 0 appends one row per bar.
+class LifterOutput {
+ public:
+  // Collective. `resumed`: a restart, which keeps the rows up to the checkpoint's time.
+  LifterOutput(const Scene& scene, const Simulation& sim, bool resumed);
+  void write(const Simulation& sim);  // collective
+
+ private:
+  std::unique_ptr<LifterBars> bars_;
+  std::unique_ptr<LifterLog> log_;
 };
 
 }  // namespace dem2d

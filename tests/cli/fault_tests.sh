@@ -558,7 +558,7 @@ disk_test() {  # NAME NP SIZE ARGS...: a run into a SIZE tmpfs, with ARGS after 
     fail "$name: exit $rc, expected 4"
   fi
   message=$(grep -m1 'error: ' "$tmp/$name.log")
-  if grep -qE "error: (cannot write )?$dir/(checkpoint\.h5(\.tmp)?|snapshots\.(h5|xmf)|series\.csv|run\.json)[: ].*(No space left|write failed|disk full)" <<< "$message"; then
+  if grep -qE "error: (cannot write )?$dir/(checkpoint\.h5(\.tmp)?|snapshots\.(h5|xmf)|series\.csv|lifters\.csv|run\.json)[: ].*(No space left|write failed|disk full)" <<< "$message"; then
     message=${message//"$dir/"/}
     pass "$name: the message names the file: ${message:0:110}"
   else
