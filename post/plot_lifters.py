@@ -31,6 +31,7 @@ import csv
 import json
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -156,7 +157,7 @@ def plot(data, bins, fig_out, path_png, title):
     if fig_out.get("loaded_from_deg") is not None:
         axes[0].set_title("shaded: the loaded window (mean normal load above 10 % of its peak)",
                           fontsize=9)
-    fig.suptitle(title)
+    fig.suptitle("\n".join(textwrap.wrap(title, 95)), fontsize=10)
     fig.tight_layout()
     fig.savefig(path_png, dpi=100)
     plt.close(fig)
