@@ -77,10 +77,8 @@ std::vector<LifterContact> LifterBars::contacts(std::span<const WallLoad> loads,
 }
 
 std::vector<LifterLoad> LifterBars::sum(std::vector<LifterContact> all, const Walls& walls) const {
-  const auto by_key = [](const LifterContact& a, const LifterContact& b) {
-    return a.id < b.id || (a.id == b.id && a.element < b.element);
-  };
-  if (!std::is_sorted(all.begin(), all.end(), by_key)) std::sort(all.begin(), all.end(), by_key);
+  if (!std::is_sorted(all.begin(), all.end(), key_before))
+    std::sort(all.begin(), all.end(), key_before);
   std::vector<LifterLoad> out(phi_.size());
   for (std::size_t b = 0; b < phi_.size(); ++b) out[b].angle_deg = angle_deg(b, walls);
   for (const LifterContact& c : all) {

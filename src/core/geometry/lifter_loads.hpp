@@ -40,6 +40,12 @@ struct LifterContact {
   double torque = 0.0;       // N m
 };
 
+// The canonical order of the contacts: by particle id, then element (one rank's wall list is
+// in this order already).
+inline bool key_before(const LifterContact& a, const LifterContact& b) {
+  return a.id < b.id || (a.id == b.id && a.element < b.element);
+}
+
 // One bar's load at one moment.
 struct LifterLoad {
   double angle_deg = 0.0;  // the bar's position, see LifterBars::angle_deg
@@ -67,8 +73,8 @@ class LifterBars {
   // This rank's records on the bars, resolved, in the records' order. `p` gives the ids.
   std::vector<LifterContact> contacts(std::span<const WallLoad> loads, const ParticleStore& p,
                                       const Walls& walls) const;
-  // Every bar's load from the contacts of all ranks (any order: sorted here by (id, element)
-  // and added per bar in that order), at the walls' current pose.
+  // Every bar's load from the contacts of all ranks (any order: sorted here by key_before
+  // unless they are already, and added per bar in that order), at the walls' current pose.
   std::vector<LifterLoad> sum(std::vector<LifterContact> all, const Walls& walls) const;
 
  private:
