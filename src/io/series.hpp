@@ -92,7 +92,8 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
      "drum scenes: the part of `drum_torque` the shell's contacts take (`drum_torque` − "
      "`lifter_torque`)"},
     {"lifter_torque", "N m", &SeriesRow::lifter_torque, SeriesOnly::kDrum,
-     "drum scenes: the part of `drum_torque` the lifters' contacts take"},
+     "drum scenes: the part of `drum_torque` the lifters' contacts take (per bar: "
+     "`lifters.csv`)"},
     {"shell_power", "W", &SeriesRow::shell_power, SeriesOnly::kDrum,
      "drum scenes: `shell_torque` × drum angular speed"},
     {"lifter_power", "W", &SeriesRow::lifter_power, SeriesOnly::kDrum,
