@@ -38,9 +38,10 @@ inline constexpr const char* kFragmentsFile = "fragments.csv";
 inline constexpr const char* kSizesFile = "sizes.csv";
 inline constexpr const char* kCheckpointFile = "checkpoint.h5";
 inline constexpr const char* kCollisionsFile = "collisions.csv";
+inline constexpr const char* kLiftersFile = "lifters.csv";
 inline constexpr const char* kRunOutputs[] = {
-    kRunJsonFile,   kSeriesFile,    kSnapshotsFile, kXdmfFile,       kProductFile,
-    kBreakagesFile, kFragmentsFile, kSizesFile,     kCheckpointFile, kCollisionsFile};
+    kRunJsonFile,   kSeriesFile, kSnapshotsFile,  kXdmfFile,       kProductFile, kBreakagesFile,
+    kFragmentsFile, kSizesFile,  kCheckpointFile, kCollisionsFile, kLiftersFile};
 inline constexpr const char* kOutputLockName = ".dem2d.lock";
 
 // Collective. Rank 0 creates `dir` (with its parents), checks that a file can be created and

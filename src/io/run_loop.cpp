@@ -41,6 +41,7 @@ RunLoop::RunLoop(Simulation& sim, const Scene& scene, Domain& domain, SeriesOutp
       series_(series),
       snapshots_(snapshots),
       ore_(scene, sim, resumed),
+      lifters_(scene, sim, resumed),
       resumed_(resumed),
       last_checkpoint_(Clock::now()) {}
 
@@ -95,6 +96,7 @@ Ending RunLoop::run(Progress& progress) {
   count_particles();
   if (!resumed_) {
     series_.write(sim_.record_row());
+    lifters_.write(sim_);
     sim_.reset_pass_window();
     if (out.snapshot_interval > 0) snapshot();
   }
@@ -130,6 +132,7 @@ void RunLoop::after_step() {
   const Due due = due_at(sim_.time());
   if (due.series) {
     series_.write(sim_.record_row());
+    lifters_.write(sim_);
     ore_.write(sim_);
     sim_.reset_pass_window();
     watch_fill();
@@ -173,7 +176,10 @@ bool RunLoop::stop_requested() {
 Ending RunLoop::finish(Ending ending) {
   count_particles();
   if (last_snapshot_time_ != sim_.time()) snapshot();
-  if (ending == Ending::kFinished && !due_at(sim_.time()).series) series_.write(sim_.record_row());
+  if (ending == Ending::kFinished && !due_at(sim_.time()).series) {
+    series_.write(sim_.record_row());
+    lifters_.write(sim_);
+  }
   if (checkpoint_step_ != sim_.step_count()) checkpoint();
   return ending;
 }

@@ -82,6 +82,7 @@ class RunLoop {
   SeriesOutput& series_;
   SnapshotWriter& snapshots_;
   OreOutput ore_;
+  LifterOutput lifters_;
   bool resumed_;
   Clock::time_point last_checkpoint_;
   double last_snapshot_time_ = -1.0;

@@ -1,7 +1,11 @@
 #include "io/run_outputs.hpp"
 
+#include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/base/errors.hpp"
 #include "io/output_dir.hpp"
@@ -53,6 +57,75 @@ void OreOutput::write(Simulation& sim) {
   std::string error;
   try {
     logs_->write(std::move(all.breakages), std::move(all.product), std::move(all.fragments));
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+}
+
+namespace {
+
+// Every rank's contacts on every rank, in key order (key_before): each rank's block, in that
+// order already, travels as [its count, 6 words per contact] (doubles bit for bit), and the
+// blocks are merged pairwise, O(n log ranks).
+std::vector<LifterContact> gather_lifter_contacts(const std::vector<LifterContact>& mine) {
+  if (mpi::size(MPI_COMM_WORLD) == 1) return mine;
+  std::vector<std::int64_t> words;
+  words.reserve(1 + 6 * mine.size());
+  words.push_back(static_cast<std::int64_t>(mine.size()));
+  for (const LifterContact& c : mine) {
+    words.insert(words.end(),
+                 {c.id, c.element, c.bar, std::bit_cast<std::int64_t>(c.normal),
+                  std::bit_cast<std::int64_t>(c.radial), std::bit_cast<std::int64_t>(c.torque)});
+  }
+  const std::vector<std::int64_t> all = mpi::all_gather(MPI_COMM_WORLD, words);
+  std::vector<LifterContact> out;
+  std::vector<std::size_t> starts;  // each rank's block in `out`
+  for (std::size_t at = 0; at < all.size();) {
+    const auto n = static_cast<std::size_t>(all[at++]);
+    starts.push_back(out.size());
+    for (std::size_t k = 0; k < n; ++k, at += 6) {
+      const std::int64_t* w = &all[at];
+      out.push_back({w[0], static_cast<std::int32_t>(w[1]), static_cast<std::int32_t>(w[2]),
+                     std::bit_cast<double>(w[3]), std::bit_cast<double>(w[4]),
+                     std::bit_cast<double>(w[5])});
+    }
+  }
+  for (std::size_t width = 1; width < starts.size(); width *= 2) {
+    for (std::size_t b = 0; b + width < starts.size(); b += 2 * width) {
+      const std::size_t end = b + 2 * width < starts.size() ? starts[b + 2 * width] : out.size();
+      const auto base = out.begin();
+      std::inplace_merge(base + static_cast<std::ptrdiff_t>(starts[b]),
+                         base + static_cast<std::ptrdiff_t>(starts[b + width]),
+                         base + static_cast<std::ptrdiff_t>(end), key_before);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+LifterOutput::LifterOutput(const Scene& scene, const Simulation& sim, bool resumed) {
+  auto bars = std::make_unique<LifterBars>(scene, sim.walls());
+  if (bars->empty()) return;
+  bars_ = std::move(bars);
+  std::string error;
+  try {
+    log_ = std::make_unique<LifterLog>(scene.output.directory + "/" + kLiftersFile,
+                                       mpi::rank(MPI_COMM_WORLD) == 0, resumed ? sim.time() : -1.0);
+  } catch (const IoError& e) {
+    error = e.what();
+  }
+  mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+}
+
+void LifterOutput::write(const Simulation& sim) {
+  if (!bars_) return;
+  const std::vector<LifterContact> all = gather_lifter_contacts(
+      bars_->contacts(sim.contacts().wall_loads(), sim.particles(), sim.walls()));
+  std::string error;
+  try {
+    if (mpi::rank(MPI_COMM_WORLD) == 0) log_->write(sim.time(), bars_->sum(all, sim.walls()));
   } catch (const IoError& e) {
     error = e.what();
   }

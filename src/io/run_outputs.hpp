@@ -1,12 +1,14 @@
-// The files a run appends to as it goes, seen from every rank: series.csv, and product.csv with
-// breakages.csv of ore scenes. Rank 0 alone writes; every write is agreed on, so a failure
-// there (disk full) stops every rank with the same message (IoError, exit 4) instead of leaving
-// the others in a collective.
+// The files a run appends to as it goes, seen from every rank: series.csv, product.csv with
+// breakages.csv of ore scenes, and lifters.csv of drums with lifters. Rank 0 alone writes;
+// every write is agreed on, so a failure there (disk full) stops every rank with the same
+// message (IoError, exit 4) instead of leaving the others in a collective.
 #pragma once
 
 #include <memory>
 
+#include "core/geometry/lifter_loads.hpp"
 #include "core/run/simulation.hpp"
+#include "io/lifter_log.hpp"
 #include "io/ore_logs.hpp"
 #include "io/series.hpp"
 
@@ -33,6 +35,21 @@ class OreOutput {
 
  private:
   std::unique_ptr<OreLogs> logs_;
+};
+
+// lifters.csv of drum scenes with lifter bars (nothing for other scenes): at a series row, the
+// last force evaluation's records on the bars, resolved on their ranks, gathered (6 words per
+// record), merged in (particle id, element) order and summed per bar in that order, the same
+// bits on any rank count; rank 0 appends one row per bar.
+class LifterOutput {
+ public:
+  // Collective. `resumed`: a restart, which keeps the rows up to the checkpoint's time.
+  LifterOutput(const Scene& scene, const Simulation& sim, bool resumed);
+  void write(const Simulation& sim);  // collective
+
+ private:
+  std::unique_ptr<LifterBars> bars_;
+  std::unique_ptr<LifterLog> log_;
 };
 
 }  // namespace dem2d

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>  // fmt::join
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -53,7 +54,11 @@ std::FILE* continue_csv(const std::string& path, const std::string& header, std:
     throw IoError(
         fmt::format("cannot continue {}: its columns are not this run's ({})", path, header));
   kept = line + "\n";
+  const auto fields = std::count(header.begin(), header.end(), ',');
   while (std::getline(in, line)) {
+    // A row with fewer fields is a torn last row (a kill mid-write), whose first field may be
+    // cut short too.
+    if (std::count(line.begin(), line.end(), ',') != fields) break;
     std::size_t at = 0;  // where the column's value starts
     for (std::size_t c = 0; c < column && at < line.size(); ++c) {
       const std::size_t comma = line.find(',', at);

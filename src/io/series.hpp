@@ -92,7 +92,8 @@ inline constexpr SeriesColumn kSeriesColumns[] = {
      "drum scenes: the part of `drum_torque` the shell's contacts take (`drum_torque` − "
      "`lifter_torque`)"},
     {"lifter_torque", "N m", &SeriesRow::lifter_torque, SeriesOnly::kDrum,
-     "drum scenes: the part of `drum_torque` the lifters' contacts take"},
+     "drum scenes: the part of `drum_torque` the lifters' contacts take (per bar: "
+     "`lifters.csv`)"},
     {"shell_power", "W", &SeriesRow::shell_power, SeriesOnly::kDrum,
      "drum scenes: `shell_torque` × drum angular speed"},
     {"lifter_power", "W", &SeriesRow::lifter_power, SeriesOnly::kDrum,
@@ -139,9 +140,11 @@ std::vector<std::string> series_columns(bool iterative, bool ore = false, bool d
 // "<!-- end columns -->"): header, separator and one line per column, each ending in '\n'.
 std::string series_columns_markdown();
 
-// A resumed run's CSV file (series.csv, product.csv, breakages.csv): keeps the header and the
-// rows whose value in column `column` is at most `limit` (the rows the interrupted run wrote
-// after its checkpoint go; the file is rewritten through a temporary renamed into place) and
+// A resumed run's CSV file (series.csv, product.csv, breakages.csv, lifters.csv): keeps the
+// header and the rows whose value in column `column` is at most `limit`, up to the first row
+// that is not (or whose field count is not the header's: a torn last row) (the rows the
+// interrupted run wrote after its checkpoint go; the file is rewritten through a temporary
+// renamed into place) and
 // returns it opened for appending; a missing file is created with the header. Throws IoError
 // when it cannot, or when the file's header is not `header` (another kind of run's file).
 std::FILE* continue_csv(const std::string& path, const std::string& header, std::size_t column,

@@ -13,7 +13,8 @@
 #     ranks in turn, until a run completes. Then: every checkpoint.h5 a kill left is a whole
 #     dem2d checkpoint; every snapshots.h5 a kill left holds only complete snapshots; the final
 #     snapshots equal an uninterrupted run's bit for bit, paired by step; series.csv has the
-#     uninterrupted run's steps, each once, and no torn row.
+#     uninterrupted run's steps, each once, and no torn row; lifters.csv is the uninterrupted
+#     run's, byte for byte.
 #  2. SIGTERM to mpirun -np 2: every rank stops, exit 1 (mpirun's), run.json says
 #     "interrupted": true, the message says where it stopped and how to resume, no
 #     checkpoint.h5.tmp or lock is left; resumed on 1 rank, the result equals an uninterrupted
@@ -321,8 +322,21 @@ def compare(first, second):
     return code == 0, (lines[-1] if lines else "")[:110]
 
 
+def same_bytes(first, second):
+    """The two files hold the same bytes (lifters.csv: the same on any rank count and across
+    restarts)."""
+    a, b = open(first, "rb").read(), open(second, "rb").read()
+    if a != b:
+        lines_a, lines_b = a.split(b"\n"), b.split(b"\n")
+        first_diff = next((i for i, (x, y) in enumerate(zip(lines_a, lines_b)) if x != y),
+                          min(len(lines_a), len(lines_b)))
+        print(f"{len(lines_b)} lines against the reference's {len(lines_a)}; the first "
+              f"difference at line {first_diff + 1}")
+    return a == b, f"{len(b)} bytes"
+
+
 CHECKS = {"checkpoints": checkpoints, "snapshots": snapshots, "series": series,
-          "runjson": runjson, "compare": compare,
+          "same_bytes": same_bytes, "runjson": runjson, "compare": compare,
           "snapshots_xmf": lambda h5, xmf: snapshots(h5, xmf=xmf)}
 
 
@@ -356,10 +370,11 @@ run_checks() {
   : > "$tmp/queue"
 }
 : > "$tmp/queue"
-same_as_reference() {  # NAME DIR [REFERENCE]: snapshots by step and series.csv against it
+same_as_reference() {  # NAME DIR [REFERENCE]: snapshots by step, series.csv and lifters.csv against it
   local against=${3:-$ref}
   queue "$1: snapshots bit-identical to the uninterrupted run's, by step" compare "$against/snapshots.h5" "$2/snapshots.h5"
   queue "$1: series.csv has the uninterrupted run's rows" series "$against/series.csv" "$2/series.csv"
+  queue "$1: lifters.csv is the uninterrupted run's, byte for byte" same_bytes "$against/lifters.csv" "$2/lifters.csv"
 }
 
 # ---------------------------------------------------------------------------------------------
@@ -558,7 +573,7 @@ disk_test() {  # NAME NP SIZE ARGS...: a run into a SIZE tmpfs, with ARGS after 
     fail "$name: exit $rc, expected 4"
   fi
   message=$(grep -m1 'error: ' "$tmp/$name.log")
-  if grep -qE "error: (cannot write )?$dir/(checkpoint\.h5(\.tmp)?|snapshots\.(h5|xmf)|series\.csv|run\.json)[: ].*(No space left|write failed|disk full)" <<< "$message"; then
+  if grep -qE "error: (cannot write )?$dir/(checkpoint\.h5(\.tmp)?|snapshots\.(h5|xmf)|series\.csv|lifters\.csv|run\.json)[: ].*(No space left|write failed|disk full)" <<< "$message"; then
     message=${message//"$dir/"/}
     pass "$name: the message names the file: ${message:0:110}"
   else
@@ -593,7 +608,7 @@ disk_test() {  # NAME NP SIZE ARGS...: a run into a SIZE tmpfs, with ARGS after 
     if [ "$rc" -eq 0 ]; then
       pass "$name: with room made, --restart on 1 rank finishes the run"
       mkdir -p "$kept/resumed"
-      cp "$dir/snapshots.h5" "$dir/series.csv" "$kept/resumed/"
+      cp "$dir/snapshots.h5" "$dir/series.csv" "$dir/lifters.csv" "$kept/resumed/"
       same_as_reference "$name" "$kept/resumed"
     else
       fail "$name: with room made, --restart exit $rc"

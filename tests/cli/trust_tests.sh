@@ -180,7 +180,7 @@ for np in 1 2; do
     "^--output $tmp/other_physics: error: output directory '$tmp/other_physics' holds the output of another run, the run '[^']*' of the deck [^ ]*waterfall\.in \(its run\.json\): its checkpoint\.h5 holds a deck whose physics differs from this one's \(1 key\)" -- \
     on "$np" "${wf[@]}" --set run.duration=0.04 --output "$tmp/other_physics" --restart "$tmp/wf/checkpoint.h5"
   expect "np$np a fresh run into a folder with a checkpoint is offered --restart first" 2 \
-    "^--output $tmp/wf: error: output directory '$tmp/wf' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf, checkpoint\.h5\), which can be continued: resume it with --restart $tmp/wf/checkpoint\.h5, or give this run a new folder with --output DIR; --overwrite replaces that output and discards its checkpoint" -- \
+    "^--output $tmp/wf: error: output directory '$tmp/wf' holds another run's output \(run\.json, series\.csv, snapshots\.h5, snapshots\.xmf, checkpoint\.h5, lifters\.csv\), which can be continued: resume it with --restart $tmp/wf/checkpoint\.h5, or give this run a new folder with --output DIR; --overwrite replaces that output and discards its checkpoint" -- \
     on "$np" "${wf[@]}" --set run.duration=0.04 --output "$tmp/wf"
 done
 

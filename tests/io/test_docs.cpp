@@ -1,6 +1,7 @@
 // The generated tables of the docs against the descriptions they come from: every key table of
 // docs/input.md (the deck's description, io/deck_schema.hpp) and the column table of
-// series.csv in docs/output.md (kSeriesColumns, io/series.hpp).
+// series.csv in docs/output.md (kSeriesColumns, io/series.hpp); the columns of lifters.csv's
+// table against the file's header (io/lifter_log.hpp).
 //
 // A generated table sits between two HTML comments, "<!-- keys: PATH -->" ... "<!-- end keys
 // -->" (PATH: "run", "drum.lifter", "top-level") or "<!-- columns: series.csv -->" ...
@@ -20,6 +21,7 @@
 #include <vector>
 
 #include "io/deck_schema.hpp"
+#include "io/lifter_log.hpp"
 #include "io/series.hpp"
 
 namespace dem2d {
@@ -156,6 +158,30 @@ TEST(DeckDocs, KeyTablesMatchTheDescription) {
 
 TEST(SeriesDocs, ColumnsMatchTheTable) {
   check_doc(kOutputDocs, "columns", {{"series.csv", series_columns_markdown()}});
+}
+
+// lifters.csv's table in docs/output.md (the first table after its heading) names the file's
+// columns, in the header's order.
+TEST(LifterDocs, TheTableNamesTheHeadersColumns) {
+  const std::string docs = read_text(kOutputDocs);
+  const std::size_t section = docs.find("\n## lifters.csv");
+  ASSERT_NE(section, std::string::npos) << "docs/output.md has no lifters.csv section";
+  std::vector<std::string> documented;
+  bool in_table = false;
+  for (const std::string& line : lines_of(docs.substr(section + 1))) {
+    if (line.starts_with("| ")) {
+      in_table = true;
+      const std::string cell = first_cell(line);
+      if (cell.size() > 2 && cell.front() == '`' && cell.back() == '`')
+        documented.push_back(cell.substr(1, cell.size() - 2));
+    } else if (in_table) {
+      break;
+    }
+  }
+  std::vector<std::string> header;
+  std::istringstream in(kLiftersHeader);
+  for (std::string column; std::getline(in, column, ',');) header.push_back(column);
+  EXPECT_EQ(documented, header);
 }
 
 // The comparison itself: a changed, missing or extra row is named by its key.

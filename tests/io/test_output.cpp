@@ -33,6 +33,7 @@
 #include "core/shape/particles.hpp"
 #include "core/shape/superellipse.hpp"
 #include "io/hdf5.hpp"
+#include "io/lifter_log.hpp"
 #include "io/output_dir.hpp"
 #include "io/series.hpp"
 #include "io/snapshots.hpp"
@@ -1469,6 +1470,54 @@ TEST(SeriesWriter, VerletHasNoPassesColumnAndInactiveWritesNothing) {
   EXPECT_FALSE(fs::exists(dir / "other.csv"));
   // Inactive on an unwritable path: no error either (only rank 0 writes).
   EXPECT_NO_THROW(SeriesWriter("/proc/dem2d_no/series.csv", false, false));
+}
+
+// lifters.csv: one row per bar, doubles read back bit for bit; a restart keeps the rows up to
+// the checkpoint's time and drops the rest, a torn last row among them even when its time was
+// cut short to a value below the checkpoint's.
+TEST(LifterLog, RowsPerBarAndARestartKeepsTheRowsUpToItsTime) {
+  ScratchDir dir;
+  if (comm_rank() != 0) return;
+  const std::string path = dir / "lifters.csv";
+  const std::vector<LifterLoad> bars = {{12.5, 1.0 / 3.0, -2.0, 7.25, 3},
+                                        {307.0, 0.0, 0.0, 0.0, 0}};
+  {
+    LifterLog log(path, true);
+    log.write(0.125, bars);
+    log.write(0.25, bars);
+  }
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[0], kLiftersHeader);
+  EXPECT_EQ(lines[1], "0.125,0,12.5,0.33333333333333331,-2,7.25,3");
+  EXPECT_EQ(lines[2], "0.125,1,307,0,0,0,0");
+  EXPECT_TRUE(same_bits(std::strtod(split(lines[1])[3].c_str(), nullptr), 1.0 / 3.0));
+  // A kill in the middle of the row of t = 0.375: "0." of it is left (read as 0 s).
+  { std::ofstream(path, std::ios::app) << "0."; }
+  {
+    LifterLog resumed(path, true, 0.25);
+    resumed.write(0.375, bars);
+  }
+  std::vector<std::string> after;
+  {
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) after.push_back(line);
+  }
+  ASSERT_EQ(after.size(), 7u);
+  EXPECT_EQ(std::vector<std::string>(after.begin(), after.begin() + 5), lines);
+  EXPECT_EQ(after[5], "0.375,0,12.5,0.33333333333333331,-2,7.25,3");
+  {
+    LifterLog earlier(path, true, 0.2);  // a checkpoint at 0.2: the rows of 0.25 and on go
+  }
+  std::ifstream in(path);
+  std::string line;
+  int count = 0;
+  while (std::getline(in, line)) ++count;
+  EXPECT_EQ(count, 3);
 }
 
 TEST(SeriesWriter, UnwritablePathIsAnIoErrorNamingIt) {

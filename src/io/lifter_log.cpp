@@ -1,0 +1,45 @@
+#include "io/lifter_log.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cstring>
+#include <iterator>
+
+#include "core/base/errors.hpp"
+#include "io/series.hpp"
+
+namespace dem2d {
+
+LifterLog::LifterLog(const std::string& path, bool active, double continue_after_time)
+    : path_(path) {
+  if (!active) return;
+  if (continue_after_time >= 0.0) {
+    file_.reset(continue_csv(path_, kLiftersHeader, 0, continue_after_time));
+    return;
+  }
+  file_.reset(std::fopen(path_.c_str(), "w"));
+  if (!file_ || std::fprintf(file_.get(), "%s\n", kLiftersHeader) < 0 ||
+      std::fflush(file_.get()) != 0)
+    throw IoError(fmt::format("cannot create {}: {}", path_, std::strerror(errno)));
+}
+
+void LifterLog::write(double time, std::span<const LifterLoad> bars) {
+  if (!file_) return;
+  std::string text;
+  for (std::size_t b = 0; b < bars.size(); ++b) {
+    const LifterLoad& l = bars[b];
+    fmt::format_to(std::back_inserter(text), "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{}\n",
+                   time, b, l.angle_deg, l.normal, l.radial, l.torque, l.contacts);
+  }
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
+      std::fflush(file_.get()) != 0) {
+    const int e = errno;
+    std::clearerr(file_.get());
+    throw IoError(
+        fmt::format("cannot write {}: {}", path_, e != 0 ? std::strerror(e) : "write error"));
+  }
+}
+
+}  // namespace dem2d

@@ -1,0 +1,171 @@
+#!/bin/bash
+# lifters.csv and post/plot_lifters.py on short runs of the thesis drum (inputs/waterfall.in):
+#   - lifters.csv is the same bytes on 1, 2 and 3 ranks, and after a run resumed from a
+#     checkpoint on another rank count;
+#   - one row per bar (0..23, in order) at every series row, at series.csv's times; the bars'
+#     angles are the drum's angle (its ramp) plus their places, from the bottom, 15 degrees
+#     apart; the bars' torques add up to series.csv's lifter_torque at every row; some bars
+#     carry the charge (contacts, a positive normal load);
+#   - a deck without lifters writes no lifters.csv;
+#   - post/plot_lifters.py draws a PNG, prints the CSV's own largest normal load as its peak
+#     (and writes it bit for bit with --json), a loaded window around the mean profile's peak,
+#     and --window keeps the rows of the last T seconds.
+#
+#   tests/post/test_lifters.sh [DEM2D [SOURCE_DIR]]
+set -u
+
+source_dir=${2:-$(cd "$(dirname "$0")/../.." && pwd)}
+dem2d=${1:-$source_dir/build/src/dem2d}
+py=/usr/bin/python3
+wf=$source_dir/inputs/waterfall.in
+work=$(mktemp -d "${TMPDIR:-/tmp}/dem2d_lifters.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+export MPLBACKEND=Agg
+export OMPI_MCA_mpi_yield_when_idle=1
+
+passed=0
+failed=0
+pass() {
+  echo "ok   $1"
+  passed=$((passed + 1))
+}
+fail() {
+  echo "FAIL $1"
+  failed=$((failed + 1))
+}
+# check NAME COMMAND...: pass when COMMAND exits 0, else fail with its output.
+check() {
+  local name=$1 out
+  shift
+  if out=$("$@" 2>&1); then pass "$name"; else
+    fail "$name"
+    sed -n '1,20p' <<<"$out"
+  fi
+}
+
+run=(--quiet --set run.duration=0.3 --set output.snapshot_interval=0)
+check "run on 1 rank" "$dem2d" "$wf" "${run[@]}" --output "$work/np1"
+check "run on 2 ranks" mpirun -np 2 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$work/np2"
+check "run on 3 ranks" mpirun -np 3 --oversubscribe "$dem2d" "$wf" "${run[@]}" --output "$work/np3"
+check "the first half on 1 rank" "$dem2d" "$wf" "${run[@]}" --set run.duration=0.15 --output "$work/rs"
+check "resumed on 2 ranks" mpirun -np 2 --oversubscribe "$dem2d" "$wf" "${run[@]}" \
+  --output "$work/rs" --restart "$work/rs/checkpoint.h5"
+for other in np2 np3 rs; do
+  check "lifters.csv: np1 = $other, byte for byte" cmp "$work/np1/lifters.csv" "$work/$other/lifters.csv"
+done
+
+check "lifters.csv against series.csv and the drum" "$py" - "$work/np1" <<'PY'
+import csv, math, sys
+d = sys.argv[1]
+rows = list(csv.reader(open(f"{d}/lifters.csv")))
+assert rows[0] == ["time", "lifter", "angle_deg", "normal_N", "radial_N", "torque_Nm",
+                   "contacts"], rows[0]
+rows = rows[1:]
+series = list(csv.DictReader(open(f"{d}/series.csv")))
+bars = 24
+assert len(rows) == bars * len(series), f"{len(rows)} rows for {len(series)} series rows"
+speed, ramp = 1.8, 0.5  # inputs/waterfall.in
+loaded = 0
+for k, s in enumerate(series):
+    group = rows[bars * k: bars * (k + 1)]
+    assert all(r[0] == s["time"] for r in group), f"times at series row {k}"
+    assert [int(r[1]) for r in group] == list(range(bars)), f"bar order at row {k}"
+    t = float(s["time"])
+    turned = 0.5 * speed * t * t / ramp if t < ramp else speed * (t - 0.5 * ramp)
+    torque, scale = 0.0, 0.0
+    for b, r in enumerate(group):
+        angle = float(r[2])
+        assert 0.0 <= angle < 360.0, angle
+        # Bar b stands at 360 b / 24 degrees counter-clockwise of +x at t = 0: 90 + 15 b from
+        # the bottom, counter-clockwise (the drum's sense).
+        want = (90.0 + 15.0 * b + math.degrees(turned)) % 360.0
+        gap = abs(angle - want)
+        assert min(gap, 360.0 - gap) < 1e-9, f"bar {b} at t = {t}: {angle} vs {want}"
+        torque += float(r[5])
+        scale += abs(float(r[5]))
+        contacts = int(r[6])
+        assert contacts >= 0
+        if contacts == 0:
+            assert float(r[3]) == 0.0 and float(r[4]) == 0.0 and float(r[5]) == 0.0, r
+        else:
+            loaded += 1
+    lt = float(s["lifter_torque"])
+    assert abs(torque - lt) <= 1e-12 * scale, f"t = {t}: sum {torque} vs {lt}"
+assert loaded > 20, f"only {loaded} loaded bar rows"
+assert max(float(r[3]) for r in rows) > 0.0, "no bar presses on the charge"
+print(f"{len(series)} series rows, {loaded} loaded bar rows")
+PY
+
+# No lifters, no file: the drum of inputs/cascade_cataract.in has none.
+check "a drum without lifters runs" "$dem2d" "$source_dir/inputs/cascade_cataract.in" --quiet \
+  --set run.duration=0.002 --output "$work/bare"
+if [ -e "$work/bare/lifters.csv" ]; then
+  fail "no lifters, no lifters.csv"
+else
+  pass "no lifters, no lifters.csv"
+fi
+
+# post/plot_lifters.py
+if out=$("$py" "$source_dir/post/plot_lifters.py" "$work/np3/lifters.csv" -o "$work/l.png" \
+  --json "$work/l.json" 2>&1); then
+  pass "plot_lifters.py runs"
+else
+  fail "plot_lifters.py runs"
+fi
+sed 's/^/     /' <<<"$out"
+check "plot_lifters.py: its figures against the CSV" "$py" - "$work/np3/lifters.csv" "$work/l.json" \
+  "$work/l.png" "$out" <<'PY'
+import csv, json, re, sys
+path, js, png, printed = sys.argv[1:5]
+rows = list(csv.DictReader(open(path)))
+f = json.load(open(js))
+normal = [float(r["normal_N"]) for r in rows]
+top = max(normal)
+assert f["rows"] == len(rows) and f["bars"] == 24, (f["rows"], f["bars"])
+assert f["peak_normal_N"] == top, (f["peak_normal_N"], top)
+k = normal.index(top)
+assert f["peak_angle_deg"] == float(rows[k]["angle_deg"])
+assert f["peak_lifter"] == int(rows[k]["lifter"])
+assert f["peak_radial_N"] == max(float(r["radial_N"]) for r in rows)
+m = re.search(r"peak normal load: ([0-9.e+-]+) N", printed)
+assert m and abs(float(m.group(1)) - top) <= 1e-8 * top, printed
+# The mean profile, binned here: its peak, and the loaded window's bins above 10 % of it with
+# the bins on either side not.
+bins = f["bins"]
+width = 360.0 / bins
+sums, counts = {}, {}
+for r in rows:
+    b = min(int(float(r["angle_deg"]) / width), bins - 1)
+    sums[b] = sums.get(b, 0.0) + float(r["normal_N"])
+    counts[b] = counts.get(b, 0) + 1
+mean = {b: sums[b] / counts[b] for b in sums}
+best = max(mean, key=mean.get)
+assert abs(f["mean_peak_normal_N"] - mean[best]) <= 1e-12 * mean[best], (f, mean[best])
+lo, hi = f["loaded_from_deg"], f["loaded_to_deg"]
+first, count = int(round(lo / width)), int(round((hi - lo) / width))
+inside = [(first + j) % bins for j in range(count)]
+assert best in inside, (lo, hi, best)
+assert all(mean.get(b, -1.0) > 0.1 * mean[best] for b in inside), "a bin of the window below 10 %"
+if count < bins:
+    for edge in (first - 1, first + count):
+        assert mean.get(edge % bins, -1.0) <= 0.1 * mean[best], f"the window stops early at {edge}"
+assert "loaded window: " in printed
+assert open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n"
+print(f"peak {top} N, loaded {lo} to {hi} deg")
+PY
+check "plot_lifters.py --window keeps the last T seconds" "$py" - "$source_dir/post/plot_lifters.py" \
+  "$work/np3/lifters.csv" "$work" <<'PY'
+import csv, json, subprocess, sys
+script, path, work = sys.argv[1:4]
+rows = list(csv.DictReader(open(path)))
+end = max(float(r["time"]) for r in rows)
+subprocess.run([sys.executable, script, path, "--window", "0.1", "--json", f"{work}/w.json",
+                "-o", f"{work}/w.png"], check=True, capture_output=True)
+f = json.load(open(f"{work}/w.json"))
+kept = [r for r in rows if float(r["time"]) >= end - 0.1]
+assert f["rows"] == len(kept) < len(rows), (f["rows"], len(kept), len(rows))
+assert f["peak_normal_N"] == max(float(r["normal_N"]) for r in kept)
+PY
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
