@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "core/run/simulation.hpp"
-#include "core/step/diagnostics.hpp"
 #include "core/shape/superellipse.hpp"
+#include "core/step/diagnostics.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {

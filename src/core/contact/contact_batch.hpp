@@ -127,8 +127,8 @@ struct WallBatch : BatchColumns<WallBatch> {
                             history);
   }
   std::array<Array<double>*, 15> outputs() {
-    return {&wx,     &wy,       &px,     &py,        &fx,      &fy, &torque, &m_roll,
-            &diss_law, &el_law, &diss_roll, &el_roll, &ex,     &ey, &et};
+    return {&wx,       &wy,     &px,        &py,      &fx, &fy, &torque, &m_roll,
+            &diss_law, &el_law, &diss_roll, &el_roll, &ex, &ey, &et};
   }
 };
 

@@ -210,10 +210,10 @@ void Kernel<Model, Shape>::evaluate_pairs(std::size_t n, double dt, EightLanes& 
       Pack ratio = kin.delta / vmin(ri, rj);
       if constexpr (Model::Tracker::kExcludes)  // a birth overlap is not the guard's concern
         ratio = (kin.delta - out.birth_overlap) / vmin(ri, rj);
-      put_pack(c, n,
-               {fx, fy, ti, tj, diss, el, ratio, -cf.f_el * nx, -cf.f_el * ny, Pack(0.0),
-                Pack(0.0)},
-               dissipated, elastic, overlap);
+      put_pack(
+          c, n,
+          {fx, fy, ti, tj, diss, el, ratio, -cf.f_el * nx, -cf.f_el * ny, Pack(0.0), Pack(0.0)},
+          dissipated, elastic, overlap);
     }
   }
 }
@@ -303,10 +303,10 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
     // The elastic normal force -f_el n on i, +f_el n on j, and its torques a x F.
     const Pack eti = -f_el * (g.aix * ny - g.aiy * nx);
     const Pack etj = f_el * (g.ajx * ny - g.ajy * nx);
-    put_pack(c, n,
-             {fx, fy, ti, tj, diss, el, select(touching, ratio, zero), -f_el * nx, -f_el * ny, eti,
-              etj},
-             dissipated, elastic, overlap);
+    put_pack(
+        c, n,
+        {fx, fy, ti, tj, diss, el, select(touching, ratio, zero), -f_el * nx, -f_el * ny, eti, etj},
+        dissipated, elastic, overlap);
   }
 }
 
