@@ -21,6 +21,10 @@ namespace {
 // contacts), at most: the shipped drum decks without snapshots took 0.94-1.33 times the estimate
 // (docs/input.md, "What --check tells").
 constexpr double kSettledCostFactor = 1.4;
+// The same for superellipses, whose contacts cost 25-55 discs' (docs/performance.md,
+// "Superellipses") while the trial's falling fill has few: inputs/shapes.in's charges of
+// rounded squares and ellipses took 11 and 13 times their estimates in processor time.
+constexpr double kShapedSettledCostFactor = 20.0;
 
 // "; asked: fill[0].bed_filling = 0.3": the fills that gave `key` (fill_fraction,
 // bed_filling) and their values, or "" when none did.
@@ -67,7 +71,7 @@ std::string dt_driver_lines(const TimeScales& ts) {
 }
 
 // The run's wall time on one rank from the trial's rate.
-std::string wall_time_line(const Trial& trial, double particle_steps, bool births) {
+std::string wall_time_line(const Trial& trial, double particle_steps, bool births, bool shaped) {
   if (trial.particle_steps_per_second <= 0.0)
     return "  wall time estimate:    none (" +
            (trial.stopped.empty() ? std::string("the trial took no step") : trial.stopped) + ")\n";
@@ -75,7 +79,10 @@ std::string wall_time_line(const Trial& trial, double particle_steps, bool birth
                     particle_steps / trial.particle_steps_per_second) +
          fmt_double(" (%.3g particle-steps/s", trial.particle_steps_per_second) +
          fmt_double(" over the first %.0f steps", static_cast<double>(trial.steps)) +
-         fmt_double("; up to %.1fx as long once the charge has settled", kSettledCostFactor) +
+         (shaped ? fmt_double("; up to %.0fx as long once the superellipses touch",
+                              kShapedSettledCostFactor)
+                 : fmt_double("; up to %.1fx as long once the charge has settled",
+                              kSettledCostFactor)) +
          "; snapshots add their own cost" +
          (births ? "; particles born by breakage and feed are not counted" : "") + ")\n";
 }
@@ -183,7 +190,7 @@ std::string check_report(const Simulation& sim, const Trial& trial) {
   out += fmt_double("  steps:                 %.0f", steps) +
          fmt_double(" for %.4g s simulated\n", s.run.duration);
   out += wall_time_line(trial, steps * static_cast<double>(p.n_owned()),
-                        s.breakage.present || s.feed.present);
+                        s.breakage.present || s.feed.present, has_shaped_particles(s));
   const double bytes =
       static_cast<double>(p.n_owned()) * p.bytes_per_particle() +
       static_cast<double>(sim.pairs().size()) * (2 * 4 + 2 * 8 + 2 * 8 * sim.pairs().width);

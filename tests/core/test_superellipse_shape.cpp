@@ -270,7 +270,7 @@ TEST(SuperEllipseShape, TheStoreCarriesShapesAndTheirInertia) {
   const std::size_t bytes = disc_only.bytes_per_particle();
   ParticleStore p;
   p.enable_shape();
-  EXPECT_EQ(p.bytes_per_particle(), bytes + 3 * sizeof(double));
+  EXPECT_EQ(p.bytes_per_particle(), bytes + 4 * sizeof(double));  // a, b, n, elastic torque
   p.add(0, 0, 0.01, 7800.0, {}, {}, 3.0);
   p.add_shaped(1, 0, 0.02, 0.01, 2.0, 7800.0, {1.0, 0.0}, {}, 3.0, 0.4);
   p.add_shaped(2, 0, 0.01, 0.01, 2.0, 7800.0, {2.0, 0.0}, {}, 3.0, 0.0);

@@ -343,9 +343,10 @@ void Kernel<Model, Shape>::scatter_pairs(ParticleStore& p, PairList& pl, std::si
     f_el[i] += ei;
     f_el[j] -= ei;
     if constexpr (kArmsApart) {
-      double* et = p.elastic_torque()->data();
-      et[i] += b_.et_i[c];
-      et[j] += b_.et_j[c];
+      if (Field<double>* et = p.elastic_torque()) {  // a store with the shape fields
+        (*et)[i] += b_.et_i[c];
+        (*et)[j] += b_.et_j[c];
+      }
     }
     for (std::size_t s = 0; s < W; ++s)
       trial[static_cast<std::size_t>(k) * W + s] = b_.history.fresh[s][c];
@@ -409,11 +410,11 @@ void Kernel<Model, Shape>::sum_records(ParticleStore& p, const PairList& pl) {
     f_el[q] = eq;
   }
   if constexpr (kArmsApart) {
-    double* et = p.elastic_torque()->data();
-    for (std::size_t q = 0; q < n_owned; ++q)
+    Field<double>* et = p.elastic_torque();  // a store with the shape fields
+    for (std::size_t q = 0; et != nullptr && q < n_owned; ++q)
       for (std::int32_t s = pl.record_start[q]; s < pl.record_start[q + 1]; ++s) {
         const std::int32_t r = index[s];
-        if (touch[r >> 1] != 0) et[q] += elastic_torque_records_[static_cast<std::size_t>(r)];
+        if (touch[r >> 1] != 0) (*et)[q] += elastic_torque_records_[static_cast<std::size_t>(r)];
       }
   }
 }

@@ -164,7 +164,8 @@ void Kernel<Model, Shape>::scatter_walls(ParticleStore& p, WallPairList& wl, std
     f[i] += fi;
     tq[i] += wb_.torque[c];
     f_el[i] += Vec2{wb_.ex[c], wb_.ey[c]};
-    if constexpr (kArmsApart) (*p.elastic_torque())[i] += wb_.et[c];
+    if constexpr (kArmsApart)
+      if (Field<double>* et = p.elastic_torque()) (*et)[i] += wb_.et[c];
     dissipated += wb_.diss_law[c];
     elastic += wb_.el_law[c];
     if constexpr (Model::Rolling::kActive) {

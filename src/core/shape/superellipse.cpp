@@ -683,7 +683,7 @@ namespace {
 // vanishes the overlap jumps. There the smallest of all local minima is taken: those of
 // kDeepDirections evenly spaced directions, each refined, the lowest kept (with `depth`, the
 // solve's own). The global minimum moves continuously with the bodies.
-constexpr double kDeepOverlap = 0.1;
+constexpr double kDeepOverlap = 0.25;
 constexpr int kDeepDirections = 64;
 
 void deepest_minimum(const Body& bi, const Body& bj, const SolveOptions& opt, DepthSolve& depth) {
