@@ -13,10 +13,12 @@ reference of the ratios. Over the last `window` seconds of each run (the second 
   - snapshots.h5: the particles' speeds in every snapshot of the window: mean, median, 90th
     percentile and their histogram (the velocity distribution);
   - lifters.csv, when the run wrote one: the normal load on the lifter bars against their angle,
-    folded onto one angle axis, its peak bin mean and the loaded window (bins above 10 % of it).
-It prints a table with each figure's ratio to the reference, writes the figures as JSON
-(--json), and draws the last snapshot of each run side by side with the speed histograms and
-the lifter loads (-o). Exit 1 when a folder lacks what it needs, 2 on bad arguments.
+    folded onto one angle axis, its peak bin mean and the loaded window around it (the bins
+    above 10 % of it), as post/plot_lifters.py reads them.
+It prints a table with each figure's ratio to the reference (angles: the difference in
+degrees), writes the figures as JSON (--json), and draws the last snapshot of each run side by
+side with the speed histograms and the lifter loads (-o). Exit 1 when a folder lacks what it
+needs, 2 on bad arguments.
 """
 
 import argparse
@@ -29,6 +31,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import millplot  # noqa: E402
+import plot_lifters  # noqa: E402
 
 
 def label_of(run, folder):
@@ -41,32 +44,18 @@ def label_of(run, folder):
     return f"superellipse n={f.get('exponent', 2.0):g} aspect {f.get('aspect', 1.0):g}"
 
 
-def read_lifters(path, t0):
-    """lifters.csv rows from time t0 as (angle_deg, normal_N) arrays, or None without the file."""
+def lifter_figures(path, window, bins=72):
+    """plot_lifters.py's figures of the last `window` seconds of lifters.csv (its peak of the mean
+    normal load per angle bin and the loaded window around it), and the mean profile; None
+    without the file."""
     if not os.path.exists(path):
         return None
-    angle, normal = [], []
-    with open(path, newline="") as f:
-        for row in csv.DictReader(f):
-            if float(row["time"]) >= t0:
-                angle.append(float(row["angle_deg"]))
-                normal.append(float(row["normal_N"]))
-    return np.asarray(angle), np.asarray(normal)
-
-
-def lifter_profile(angle, normal, bins=72):
-    """Mean normal load per angle bin (deg): bin centres, means, the peak mean and the loaded
-    window (first and last bin centre above 10 % of the peak)."""
-    edges = np.linspace(0.0, 360.0, bins + 1)
-    k = np.clip(np.digitize(angle % 360.0, edges) - 1, 0, bins - 1)
-    sums = np.bincount(k, weights=normal, minlength=bins)
-    counts = np.bincount(k, minlength=bins)
-    mean = np.divide(sums, counts, out=np.zeros(bins), where=counts > 0)
-    centres = 0.5 * (edges[:-1] + edges[1:])
-    peak = float(mean.max()) if len(mean) else 0.0
-    loaded = centres[mean > 0.1 * peak] if peak > 0 else np.array([])
-    window = [float(loaded.min()), float(loaded.max())] if len(loaded) else None
-    return centres, mean, peak, window
+    data = plot_lifters.select_window(plot_lifters.read_lifters(path), window)
+    if len(data["time"]) == 0:
+        return None
+    mean, _ = plot_lifters.binned(data["angle_deg"], data["normal_N"], bins)
+    centres = (np.arange(bins) + 0.5) * 360.0 / bins
+    return plot_lifters.figures(data, bins), centres, mean
 
 
 def measure(folder, window):
@@ -99,10 +88,12 @@ def measure(folder, window):
     v = np.concatenate(speeds)
     out.update({"speed_mean": float(v.mean()), "speed_median": float(np.median(v)),
                 "speed_p90": float(np.percentile(v, 90.0)), "snapshots": len(speeds)})
-    lifters = read_lifters(os.path.join(folder, "lifters.csv"), t0)
-    if lifters is not None and len(lifters[0]):
-        centres, mean, peak, loaded = lifter_profile(*lifters)
-        out.update({"lifter_peak_normal_N": peak, "lifter_loaded_window_deg": loaded})
+    lifters = lifter_figures(os.path.join(folder, "lifters.csv"), window)
+    if lifters is not None:
+        fig, centres, mean = lifters
+        out["lifter_peak_normal_N"] = fig["mean_peak_normal_N"]
+        out["lifter_peak_angle_deg"] = fig["mean_peak_angle_deg"]
+        out["lifter_loaded_window_deg"] = [fig["loaded_from_deg"], fig["loaded_to_deg"]]
         out["_lifter_profile"] = (centres, mean)
     out["_speeds"] = v
     out["_last"] = last
@@ -113,26 +104,33 @@ def measure(folder, window):
 FIGURES = [("shoulder_angle_deg", "shoulder angle [deg]"), ("toe_angle_deg", "toe angle [deg]"),
            ("power_W", "drive power [W]"), ("speed_mean", "mean speed [m/s]"),
            ("speed_median", "median speed [m/s]"), ("speed_p90", "90th pct speed [m/s]"),
-           ("lifter_peak_normal_N", "lifter peak normal load [N]")]
+           ("lifter_peak_normal_N", "lifter mean normal load, peak [N]"),
+           ("lifter_peak_angle_deg", "... at the angle [deg]")]
 
 
 def table(runs):
+    """Each figure of each run with its ratio to the first run's (angles: the difference, deg)."""
     ref = runs[0]
-    lines = [f"{'':28s}" + "".join(f"{r['label'][:26]:>28s}" for r in runs)]
+    w = 32
+    lines = [f"{'':28s}" + "".join(f"{r['label'][:w - 2]:>{w}s}" for r in runs)]
     lines.append(f"{'charge mass [kg]':28s}" +
-                 "".join(f"{r['charge_mass_kg'] or float('nan'):>28.4g}" for r in runs))
+                 "".join(f"{r['charge_mass_kg'] or float('nan'):>{w}.4g}" for r in runs))
     for key, name in FIGURES:
         if key not in ref:
             continue
         cells = []
         for r in runs:
             value = r.get(key, float("nan"))
-            ratio = value / ref[key] if ref[key] else float("nan")
-            cells.append(f"{value:>14.4g} ({ratio:5.2f}x)")
-        lines.append(f"{name:28s}" + "".join(f"{c:>28s}" for c in cells))
+            if key.endswith("_deg"):
+                change = (value - ref[key] + 180.0) % 360.0 - 180.0
+                cells.append(f"{value:>10.4g} ({change:+6.1f})")
+            else:
+                ratio = value / ref[key] if ref[key] else float("nan")
+                cells.append(f"{value:>10.4g} ({ratio:5.2f}x)")
+        lines.append(f"{name:28s}" + "".join(f"{c:>{w}s}" for c in cells))
     if "lifter_loaded_window_deg" in ref:
         lines.append(f"{'lifter loaded [deg]':28s}" + "".join(
-            f"{'%.0f-%.0f' % tuple(r['lifter_loaded_window_deg']) if r.get('lifter_loaded_window_deg') else '-':>28s}"
+            f"{'%.0f-%.0f' % tuple(r['lifter_loaded_window_deg']) if r.get('lifter_loaded_window_deg') else '-':>{w}s}"
             for r in runs))
     return "\n".join(lines)
 

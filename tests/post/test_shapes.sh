@@ -381,7 +381,7 @@ for folder, r in zip(sys.argv[1:3], runs):
 assert abs(runs[0]['charge_mass_kg'] - runs[1]['charge_mass_kg']) <= 1e-12 * runs[0]['charge_mass_kg']
 assert runs[0]['particles'] == runs[1]['particles']
 text = open(sys.argv[3].replace('cmp.json', 'cmp.txt')).read()
-assert '( 1.00x)' in text.splitlines()[2], text
+assert [l for l in text.splitlines() if l.startswith('drive power')][0].split('W]')[1].split()[1:3] == ['(', '1.00x)'], text
 print('compare_shapes figures recomputed')
 PY"
 
