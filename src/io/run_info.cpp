@@ -5,6 +5,7 @@
 
 #include "core/mill/grinding.hpp"
 #include "core/mill/mill_analytics.hpp"
+#include "core/shape/superellipse_shape.hpp"
 #include "io/grinding_report.hpp"
 #include "io/text.hpp"
 
@@ -91,6 +92,26 @@ void add_decomposition(JsonObject& extra, const MpiDomain& domain) {
       .add_integer("sectors", domain.partition().n_sectors);
 }
 
+// The superellipse's contact solves over every rank's process since its start (a restarted run
+// counts from the restart): pair solves (contacts in touch), those from a cold start (a new
+// contact), the depth's evaluations per pair solve, the solves that did not converge (they keep
+// the last iterate, docs/models.md), and the wall solves. Collective.
+std::string shape_solves_json(const MpiDomain& domain) {
+  const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
+  const std::int64_t pairs = domain.sum(std::int64_t{st.pair_solves});
+  const std::int64_t evaluations = domain.sum(std::int64_t{st.pair_iterations});
+  JsonObject o;
+  o.add_integer("pair_solves", pairs)
+      .add_integer("pair_cold_starts", domain.sum(std::int64_t{st.pair_cold}))
+      .add_number("depth_evaluations_per_pair_solve",
+                  pairs > 0 ? static_cast<double>(evaluations) / static_cast<double>(pairs) : 0.0,
+                  "%.4g")
+      .add_integer("pair_unconverged", domain.sum(std::int64_t{st.pair_unconverged}))
+      .add_integer("wall_solves", domain.sum(std::int64_t{st.wall_solves}))
+      .add_integer("wall_unconverged", domain.sum(std::int64_t{st.wall_unconverged}));
+  return o.inline_text();
+}
+
 }  // namespace
 
 RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
@@ -113,6 +134,7 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
     extra.add("grinding", grinding_json(grinding_report(sim, domain)).inline_text());
   }
   extra.add_integer("neighbor_builds", sim.neighbor_builds());
+  if (has_shaped_particles(scene)) extra.add("superellipse_contacts", shape_solves_json(domain));
   if (scene.run.integrator == IntegratorKind::kIterative) {
     extra.add_number("mean_passes",
                      static_cast<double>(sim.passes_total()) /

@@ -291,6 +291,15 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 check "dem2d runs tests/post/shapes.in on 1 and 2 ranks" \
   bash -c "'$dem2d' --quiet --output '$work/run1' '$deck' &&
            mpirun -np 2 --oversubscribe '$dem2d' --quiet --output '$work/run2' '$deck'"
+check "run.json counts the superellipse solves: none unconverged, 1-10 evaluations each" \
+  "$py" -c "
+import json, sys
+c = json.load(open(sys.argv[1]))['superellipse_contacts']
+assert c['pair_solves'] > 0 and c['wall_solves'] > 0, c
+assert c['pair_unconverged'] == 0 and c['wall_unconverged'] == 0, c
+assert 0 < c['pair_cold_starts'] < c['pair_solves'], c
+assert 1.0 <= c['depth_evaluations_per_pair_solve'] <= 10.0, c
+" "$work/run1/run.json"
 check "1 and 2 ranks: the same snapshots, outlines included (h5compare.py)" \
   "$py" "$post/h5compare.py" "$work/run1/snapshots.h5" "$work/run2/snapshots.h5"
 check "check_xdmf.py on both runs' snapshots.xmf" \
