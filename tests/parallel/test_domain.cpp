@@ -602,6 +602,27 @@ TEST(Reproducibility, SizeAwareOreWithT10ProgenyAndOverflow) {
   });
 }
 
+// The same mill with superellipse ore (rounded boxes n = 4 of aspect 0.6 at random angles):
+// their breaks make superellipse fragments, alike on every rank count.
+TEST(Reproducibility, SuperellipseOreBreaksAlike) {
+  Scene s = ore_across_sectors();
+  s.title = "superellipse ore breaking, feed and sieve";
+  for (FillSpec& f : s.fills) {
+    f.count = 50;
+    f.shape = ParticleShape::kSuperellipse;
+    f.aspect = 0.6;
+    f.exponent = 4.0;
+  }
+  expect_same_as_serial(s, 12000, 2000, [](const Simulation& ser) {
+    EXPECT_GE(ser.grinding()->totals().breakages, 3);
+    const ParticleStore& p = ser.particles();
+    int fragments = 0;
+    for (std::size_t k = 0; k < p.n_owned(); ++k)
+      fragments += p.id[k] >= 100 && (*p.exponent())[k] == 4.0;
+    EXPECT_GT(fragments, 0) << "superellipse fragments in the store";
+  });
+}
+
 TEST(Reproducibility, ThesisWaterfallScene) {
   Scene s = thesis_drum(240, 1.8, 16);
   s.title = "thesis waterfall (240 balls, 16-gon, 1.8 rad/s)";
