@@ -7,6 +7,7 @@
 #include <iterator>
 
 #include "core/base/errors.hpp"
+#include "io/output_dir.hpp"
 #include "io/series.hpp"
 
 namespace dem2d {
@@ -32,14 +33,7 @@ void LifterLog::write(double time, std::span<const LifterLoad> bars) {
     fmt::format_to(std::back_inserter(text), "{:.17g},{},{:.17g},{:.17g},{:.17g},{:.17g},{}\n",
                    time, b, l.angle_deg, l.normal, l.radial, l.torque, l.contacts);
   }
-  errno = 0;
-  if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
-      std::fflush(file_.get()) != 0) {
-    const int e = errno;
-    std::clearerr(file_.get());
-    throw IoError(
-        fmt::format("cannot write {}: {}", path_, e != 0 ? std::strerror(e) : "write error"));
-  }
+  append_to_log(file_.get(), path_, text);
 }
 
 }  // namespace dem2d

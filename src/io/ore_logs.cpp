@@ -66,13 +66,7 @@ void OreLogs::write(std::vector<BreakageRecord> breakages, std::vector<ProductRe
 }
 
 void OreLogs::put(std::FILE* f, const std::string& path, const std::string& text) {
-  errno = 0;
-  if (std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fflush(f) != 0) {
-    const int e = errno;
-    std::clearerr(f);
-    throw IoError(
-        fmt::format("cannot write {}: {}", path, e != 0 ? std::strerror(e) : "write error"));
-  }
+  append_to_log(f, path, text);
 }
 
 }  // namespace dem2d

@@ -297,6 +297,16 @@ OutputLock claim_output_directory(MPI_Comm comm, const std::string& dir, Claim h
 
 // Writes `text` to `path` through a temporary file and a rename, so that a reader never sees
 // a half-written file. Returns an error message, empty on success.
+void append_to_log(std::FILE* f, const std::string& path, std::string_view text) {
+  errno = 0;
+  if (std::fwrite(text.data(), 1, text.size(), f) != text.size() || std::fflush(f) != 0) {
+    const int e = errno;
+    std::clearerr(f);
+    throw IoError(
+        fmt::format("cannot write {}: {}", path, e != 0 ? std::strerror(e) : "write error"));
+  }
+}
+
 std::string write_file_atomically(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
   std::FILE* f = std::fopen(tmp.c_str(), "wb");

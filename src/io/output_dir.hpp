@@ -3,7 +3,9 @@
 // run claims its folder with a lock file naming its host and pid, removed when the run ends.
 #pragma once
 
+#include <cstdio>
 #include <string>
+#include <string_view>
 
 #include "parallel/comm.hpp"
 
@@ -70,5 +72,10 @@ void ensure_free_space(MPI_Comm comm, const std::string& path, std::uint64_t byt
 // a half-written file (snapshots.xmf, collisions.csv). Returns an error message, empty on
 // success.
 std::string write_file_atomically(const std::string& path, const std::string& text);
+
+// Appends `text` to the open log `f` (series.csv, lifters.csv, the ore logs) and flushes it, so
+// that the rows written are on disk if the run stops; an IoError naming `path` and the system's
+// reason when the write or the flush fails.
+void append_to_log(std::FILE* f, const std::string& path, std::string_view text);
 
 }  // namespace dem2d

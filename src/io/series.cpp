@@ -13,6 +13,7 @@
 #include <type_traits>
 
 #include "core/base/errors.hpp"
+#include "io/output_dir.hpp"
 
 namespace dem2d {
 
@@ -117,15 +118,6 @@ void SeriesWriter::write(const SeriesRow& r) {
   put(line);
 }
 
-void SeriesWriter::put(const std::string& text) {
-  errno = 0;
-  if (std::fwrite(text.data(), 1, text.size(), file_.get()) != text.size() ||
-      std::fflush(file_.get()) != 0) {
-    const int e = errno;
-    std::clearerr(file_.get());
-    throw IoError(
-        fmt::format("cannot write {}: {}", path_, e != 0 ? std::strerror(e) : "write error"));
-  }
-}
+void SeriesWriter::put(const std::string& text) { append_to_log(file_.get(), path_, text); }
 
 }  // namespace dem2d

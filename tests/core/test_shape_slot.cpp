@@ -17,6 +17,7 @@
 
 #include "core/contact/kernel_factory.hpp"
 #include "core/contact/neighbors.hpp"
+#include "support/kernel_bodies.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {
@@ -112,94 +113,15 @@ struct EccentricDisc : CountingDisc {
   }
 };
 
-// Two bodies (and walls) run by one kernel with velocity Verlet, the lists rebuilt every step.
+// Bodies and walls run by one kernel with velocity Verlet (support/kernel_bodies.hpp).
 template <class Model, class Shape>
-struct Bodies {
-  Scene scene;
-  PairTable table;
-  Walls walls;
-  kernels::Kernel<Model, Shape> kernel;
-  ParticleStore p;
-  NeighborSearch search;
-  PairList pl;
-  WallPairList wl;
-  std::vector<WallLoad> loads;
-  EvaluationTotals tot;
-  std::vector<double> inertia;
-  double dt;
-  double dissipated = 0.0;
+using Bodies = testing_support::KernelBodies<Model, Shape>;
 
-  explicit Bodies(const Scene& s)
-      : scene(s), table(s), walls(s), kernel(s.contact, table), dt(s.run.dt) {
-    pl.width = wl.width = kernel.history_slots().size();
-    search.set_pair_trials(true);
-    for (std::size_t k = 0; k < s.particles.size(); ++k) {
-      const ParticleSpec& b = s.particles[k];
-      p.add(static_cast<std::int64_t>(k), 0, b.radius, s.materials[0].density, b.position,
-            b.velocity, b.spin);
-      inertia.push_back(1.0 / p.inv_inertia[k]);
-    }
-  }
-  // Mass and moment of inertia of body k set by hand (the eccentric disc).
-  void set_inertia(std::size_t k, double m, double moment) {
-    p.mass[k] = m;
-    p.inv_mass[k] = 1.0 / m;
-    p.inv_inertia[k] = 1.0 / moment;
-    inertia[k] = moment;
-  }
-  void forces() {
-    search.build(p, walls, 0.2 * p.radius[0], pl, wl);
-    kernel.lists_changed();
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.force[k] = p.mass[k] * scene.run.gravity;
-      p.torque[k] = 0.0;
-      p.elastic_force[k] = {};
-    }
-    kernel.evaluate(p, walls, pl, wl, dt, tot, loads);
-    dissipated += tot.dissipated;
-    if (!kernel.histories_in_place()) pl.history.swap(pl.trial);
-    wl.history.swap(wl.trial);
-    kernel.committed();
-  }
-  void kick() {
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.vel[k] += (0.5 * dt * p.inv_mass[k]) * p.force[k];
-      p.omega[k] += 0.5 * dt * p.inv_inertia[k] * p.torque[k];
-    }
-  }
-  void step() {
-    kick();
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.pos[k] += dt * p.vel[k];
-      p.theta[k] += dt * p.omega[k];
-    }
-    forces();
-    kick();
-  }
-  // The shape's own slot (the last) of the pair (0, 1), 0 when not listed.
-  double pair_steps() const {
-    for (std::size_t k = 0; k < pl.size(); ++k) return pl.history_of(k)[pl.width - 1];
-    return 0.0;
-  }
-  double kinetic() const {
-    double e = 0.0;
-    for (std::size_t k = 0; k < p.size(); ++k)
-      e += 0.5 * p.mass[k] * norm2(p.vel[k]) + 0.5 * inertia[k] * p.omega[k] * p.omega[k];
-    return e;
-  }
-  Vec2 momentum() const {
-    Vec2 out{};
-    for (std::size_t k = 0; k < p.size(); ++k) out += p.mass[k] * p.vel[k];
-    return out;
-  }
-  // About the origin: sum of m x cross v + I w.
-  double angular_momentum() const {
-    double out = 0.0;
-    for (std::size_t k = 0; k < p.size(); ++k)
-      out += p.mass[k] * cross(p.pos[k], p.vel[k]) + inertia[k] * p.omega[k];
-    return out;
-  }
-};
+// The shape's own slot (the last) of the first listed pair, 0 when none is listed.
+double pair_steps(const PairList& pl) {
+  for (std::size_t k = 0; k < pl.size(); ++k) return pl.history_of(k)[pl.width - 1];
+  return 0.0;
+}
 
 // Steel balls, a steel floor at y = 0 when `floor`, the given law and rolling model.
 Scene two_balls(ContactModelKind law, RollingModelKind rolling, double restitution, double mu_s,
@@ -245,8 +167,8 @@ void expect_general_path_is_the_discs(ContactModelKind law, RollingModelKind rol
     const bool touching =
         general.pl.size() > 0 && !(norm2(general.p.pos[1] - general.p.pos[0]) >= rsum * rsum);
     steps_in_contact = touching ? steps_in_contact + 1 : 0;
-    ASSERT_EQ(general.pair_steps(), steps_in_contact) << "step " << n;
-    max_steps = std::max(max_steps, general.pair_steps());
+    ASSERT_EQ(pair_steps(general.pl), steps_in_contact) << "step " << n;
+    max_steps = std::max(max_steps, pair_steps(general.pl));
   }
   EXPECT_GT(max_force, 1.0) << "the bodies collided";
   EXPECT_GT(max_steps, 10.0) << "the pair stayed in contact for a while";

@@ -19,6 +19,7 @@
 #include "core/run/simulation.hpp"
 #include "core/shape/superellipse_shape.hpp"
 #include "core/step/energy_ledger.hpp"
+#include "support/kernel_bodies.hpp"
 #include "support/scenes.hpp"
 
 namespace dem2d {
@@ -28,67 +29,9 @@ using testing_support::make_material;
 using testing_support::rigid_wall_material;
 using testing_support::segment;
 
-// Two or more bodies (and walls) run by one kernel with velocity Verlet, the lists rebuilt every
-// step (as in test_shape_slot.cpp); `shaped`: the store carries the shape fields (a disc there
-// is a = b = r, n = 2).
+// Bodies and walls run by one kernel with velocity Verlet (support/kernel_bodies.hpp).
 template <class Model, class Shape>
-struct Bodies {
-  Scene scene;
-  PairTable table;
-  Walls walls;
-  kernels::Kernel<Model, Shape> kernel;
-  ParticleStore p;
-  NeighborSearch search;
-  PairList pl;
-  WallPairList wl;
-  std::vector<WallLoad> loads;
-  EvaluationTotals tot;
-  double dt;
-
-  Bodies(const Scene& s, bool shaped)
-      : scene(s), table(s), walls(s), kernel(s.contact, table), dt(s.run.dt) {
-    pl.width = wl.width = kernel.history_slots().size();
-    search.set_pair_trials(true);
-    if (shaped) p.enable_shape();
-    for (std::size_t k = 0; k < s.particles.size(); ++k) {
-      const ParticleSpec& b = s.particles[k];
-      if (b.shaped())
-        p.add_shaped(static_cast<std::int64_t>(k), 0, b.semi_a, b.semi_b, b.exponent,
-                     s.materials[0].density, b.position, b.velocity, b.spin, b.angle);
-      else
-        p.add(static_cast<std::int64_t>(k), 0, b.radius, s.materials[0].density, b.position,
-              b.velocity, b.spin);
-    }
-  }
-  void forces() {
-    search.build(p, walls, 0.2 * p.radius[0], pl, wl);
-    kernel.lists_changed();
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.force[k] = p.mass[k] * scene.run.gravity;
-      p.torque[k] = 0.0;
-      p.elastic_force[k] = {};
-    }
-    kernel.evaluate(p, walls, pl, wl, dt, tot, loads);
-    if (!kernel.histories_in_place()) pl.history.swap(pl.trial);
-    wl.history.swap(wl.trial);
-    kernel.committed();
-  }
-  void kick() {
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.vel[k] += (0.5 * dt * p.inv_mass[k]) * p.force[k];
-      p.omega[k] += 0.5 * dt * p.inv_inertia[k] * p.torque[k];
-    }
-  }
-  void step() {
-    kick();
-    for (std::size_t k = 0; k < p.size(); ++k) {
-      p.pos[k] += dt * p.vel[k];
-      p.theta[k] += dt * p.omega[k];
-    }
-    forces();
-    kick();
-  }
-};
+using Bodies = testing_support::KernelBodies<Model, Shape>;
 
 // The disc through the general path with the superellipse's arm convention for pairs: both arms
 // end at the contact point midway in the overlap, (r_i - delta/2) n from i and -(r_j - delta/2) n

@@ -23,25 +23,7 @@ trap 'rm -rf "$work"' EXIT
 export MPLBACKEND=Agg
 export OMPI_MCA_mpi_yield_when_idle=1
 
-passed=0
-failed=0
-pass() {
-  echo "ok   $1"
-  passed=$((passed + 1))
-}
-fail() {
-  echo "FAIL $1"
-  failed=$((failed + 1))
-}
-# check NAME COMMAND...: pass when COMMAND exits 0, else fail with its output.
-check() {
-  local name=$1 out
-  shift
-  if out=$("$@" 2>&1); then pass "$name"; else
-    fail "$name"
-    sed -n '1,20p' <<<"$out"
-  fi
-}
+source "${BASH_SOURCE[0]%/*}/checks.sh"
 
 run=(--quiet --set run.duration=0.3 --set output.snapshot_interval=0)
 check "run on 1 rank" "$dem2d" "$wf" "${run[@]}" --output "$work/np1"
@@ -167,5 +149,4 @@ assert f["rows"] == len(kept) < len(rows), (f["rows"], len(kept), len(rows))
 assert f["peak_normal_N"] == max(float(r["normal_N"]) for r in kept)
 PY
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

@@ -21,41 +21,7 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/dem2d_pbm.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 export MPLBACKEND=Agg
 
-passed=0
-failed=0
-pass() {
-  echo "ok   $1"
-  passed=$((passed + 1))
-}
-fail() {
-  echo "FAIL $1"
-  failed=$((failed + 1))
-}
-# check NAME COMMAND...: pass when COMMAND exits 0, else fail with its output.
-check() {
-  local name=$1 out
-  shift
-  if out=$("$@" 2>&1); then pass "$name"; else
-    fail "$name"
-    sed -n '1,15p' <<<"$out"
-  fi
-}
-
-# png_ok FILE...: each file is a PNG at least 200 px wide with more than 20 colours (not blank).
-png_ok() {
-  "$py" - "$@" <<'EOF'
-import sys
-import matplotlib.image as mpimg
-import numpy as np
-for path in sys.argv[1:]:
-    with open(path, "rb") as f:
-        assert f.read(8) == b"\x89PNG\r\n\x1a\n", f"{path}: not a PNG"
-    img = mpimg.imread(path)
-    assert img.shape[0] >= 200 and img.shape[1] >= 200, f"{path}: {img.shape}"
-    colours = np.unique((img[..., :3] * 255).astype(np.uint8).reshape(-1, 3), axis=0)
-    assert len(colours) > 20, f"{path}: only {len(colours)} colours"
-EOF
-}
+source "${BASH_SOURCE[0]%/*}/checks.sh"
 
 # --- A short run: 4 s of the grate mill, breakage from 1.5 s, spectra on -------------------------
 # f_mat = 0.5 (ten times the deck's) so that some 90 breaks happen in 2.5 s; breakage starts at
@@ -273,5 +239,4 @@ else
 fi
 
 echo "pbm tests: $((SECONDS - start)) s"
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

@@ -27,20 +27,7 @@ work=$(mktemp -d "${TMPDIR:-/tmp}/dem2d_shapes.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 export MPLBACKEND=Agg
 
-passed=0
-failed=0
-check() {
-  local name=$1 out
-  shift
-  if out=$("$@" 2>&1); then
-    echo "ok   $name"
-    passed=$((passed + 1))
-  else
-    echo "FAIL $name"
-    sed -n '1,20p' <<<"$out"
-    failed=$((failed + 1))
-  fi
-}
+source "${BASH_SOURCE[0]%/*}/checks.sh"
 
 # measure.py H5 JSON: checks render_snapshot.py's --json output JSON against the snapshots of H5.
 cat >"$work/measure.py" <<'EOF'
@@ -394,5 +381,4 @@ assert [l for l in text.splitlines() if l.startswith('drive power')][0].split('W
 print('compare_shapes figures recomputed')
 PY"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

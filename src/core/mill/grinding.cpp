@@ -14,6 +14,7 @@
 #include "core/geometry/walls.hpp"
 #include "core/mill/breakage_laws.hpp"
 #include "core/shape/disc.hpp"
+#include "core/shape/superellipse.hpp"
 #include "core/shape/superellipse_sizing.hpp"
 
 namespace dem2d {
@@ -397,10 +398,11 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
     plan_.sieved_mass += p.mass[k];
     ++plan_.sieved;
   };
+  EquivalentRadii radii;
   if (s.type != DischargeType::kOverflow) {
     for (std::size_t k = 0; k < p.n_owned(); ++k)
-      if (plan_.remove[k] == 0 && p.material[k] == sieve_material_ &&
-          2.0 * size_radius(p, k) < s.aperture && in_zone(p.pos[k]))
+      if (plan_.remove[k] == 0 && p.material[k] == sieve_material_ && in_zone(p.pos[k]) &&
+          2.0 * size_radius(p, k, radii) < s.aperture)
         out(k);
     return;
   }
@@ -409,9 +411,11 @@ void Grinding::discharge(double time, const ParticleStore& p, Domain& domain) {
   for (std::size_t k = 0; k < p.n_owned(); ++k) {
     if (p.material[k] != sieve_material_) continue;
     held += SizeMasses::units(p.mass[k]);
-    if (plan_.remove[k] == 0 && 2.0 * size_radius(p, k) < s.aperture)
-      fine.insert(fine.end(), {std::bit_cast<std::int64_t>(size_radius(p, k)), p.id[k],
-                               SizeMasses::units(p.mass[k])});
+    if (plan_.remove[k] != 0) continue;
+    const double r = size_radius(p, k, radii);
+    if (2.0 * r < s.aperture)
+      fine.insert(fine.end(),
+                  {std::bit_cast<std::int64_t>(r), p.id[k], SizeMasses::units(p.mass[k])});
   }
   held = domain.sum(held);
   const std::int64_t limit = SizeMasses::units(s.holdup);

@@ -155,4 +155,9 @@ double size_radius(const ParticleStore& p, std::size_t k) {
   return equivalent_radius(SuperEllipse{(*p.semi_a())[k], (*p.semi_b())[k], (*p.exponent())[k]});
 }
 
+double size_radius(const ParticleStore& p, std::size_t k, EquivalentRadii& radii) {
+  if (!p.shaped()) return p.radius[k];
+  return radii(SuperEllipse{(*p.semi_a())[k], (*p.semi_b())[k], (*p.exponent())[k]});
+}
+
 }  // namespace dem2d

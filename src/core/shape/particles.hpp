@@ -210,6 +210,9 @@ class ParticleStore {
 // The radius that sizes particle k (its sieve size is twice it): a disc's radius, a
 // superellipse's volume-equivalent radius (the sphere of its mass; core/shape/superellipse.hpp).
 double size_radius(const ParticleStore& p, std::size_t k);
+// The same, the superellipse's Gamma functions kept in `radii` while the exponent repeats.
+class EquivalentRadii;
+double size_radius(const ParticleStore& p, std::size_t k, EquivalentRadii& radii);
 
 // 1/2 I w^2 of particle k: the disc's formula in a store without shaped particles (its bits
 // unchanged), else from the stored inverse inertia.

@@ -207,14 +207,28 @@ double area(const SuperEllipse& s) {
   return 4.0 * s.a * s.b * g1 * g1 / std::tgamma(1.0 + 2.0 / s.n);
 }
 
-double volume(const SuperEllipse& s) {
+namespace {
+// The volume from g1 = Gamma(1 + 1/n) and g3 = Gamma(1 + 3/n).
+double volume_of(const SuperEllipse& s, double g1, double g3) {
   const double c = std::min(s.a, s.b);
-  const double g1 = std::tgamma(1.0 + 1.0 / s.n);
-  return 8.0 * s.a * s.b * c * g1 * g1 * g1 / std::tgamma(1.0 + 3.0 / s.n);
+  return 8.0 * s.a * s.b * c * g1 * g1 * g1 / g3;
+}
+double radius_of_volume(double v) { return std::cbrt(3.0 * v / (4.0 * std::numbers::pi)); }
+}  // namespace
+
+double volume(const SuperEllipse& s) {
+  return volume_of(s, std::tgamma(1.0 + 1.0 / s.n), std::tgamma(1.0 + 3.0 / s.n));
 }
 
-double equivalent_radius(const SuperEllipse& s) {
-  return std::cbrt(3.0 * volume(s) / (4.0 * std::numbers::pi));
+double equivalent_radius(const SuperEllipse& s) { return radius_of_volume(volume(s)); }
+
+double EquivalentRadii::operator()(const SuperEllipse& s) {
+  if (s.n != n_) {
+    n_ = s.n;
+    g1_ = std::tgamma(1.0 + 1.0 / s.n);
+    g3_ = std::tgamma(1.0 + 3.0 / s.n);
+  }
+  return radius_of_volume(volume_of(s, g1_, g3_));
 }
 
 double mass(const SuperEllipse& s, double density) { return density * volume(s); }
