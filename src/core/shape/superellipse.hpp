@@ -205,7 +205,7 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
 // is tried before everything else, by the same test as the search's directions; when it separates
 // them the pair is apart (delta: the gap along it, n: it, angle left 0), else the solve goes on
 // exactly as without it. It proves the bodies apart and nothing more. Not for n > 2: there the
-// solve below can end at a small positive overlap (1e-7 to 2e-6 m seen, for bodies of bounding
+// solve below can end at a small positive overlap (up to 2.2e-6 m seen, for bodies of bounding
 // radius 0.1 m) on two near-parallel flat faces of bodies that an earlier step's axis still shows
 // apart (the minimisation's false convergence next to a face's middle, docs/performance.md), so the
 // axis would turn such contacts into pairs apart and change the results.

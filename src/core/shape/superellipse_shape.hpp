@@ -45,11 +45,11 @@
 // DepthStart::axis): bodies move little in a step, so it mostly still separates them. It only
 // ever proves a pair apart, so the contacts found are the same with or without it (a rebuilt list
 // or a migrated pair loses it, which costs time only); for n > 2 it is not used (see
-// DepthStart). Each body's cos and sin of its angle come from the kernel too,
-// taken once per body and evaluation. Unconverged solves (the depth's
-// minimisation, the shell's iteration): counted in SuperEllipseShape::stats() (this process), with
-// the number of solves and the depth's evaluations (a kernel call's pair counts added once at its
-// end); an unconverged pair keeps the last iterate (an overlap along a direction near the normal).
+// DepthStart). Each body's cos and sin of its angle come from the kernel too, taken once per body
+// and evaluation. Unconverged solves (the depth's minimisation, the shell's iteration): counted in
+// SuperEllipseShape::stats() (this process), with the number of solves, the depth's evaluations
+// and their histogram per solve (a kernel call's pair counts added once at its end); an
+// unconverged pair keeps the last iterate (an overlap along a direction near the normal).
 #pragma once
 
 #include <algorithm>
