@@ -95,17 +95,23 @@ void add_decomposition(JsonObject& extra, const MpiDomain& domain) {
 // The superellipse's contact solves over every rank's process since its start (a restarted run
 // counts from the restart): pair solves (contacts in touch), those from a cold start (a new
 // contact), the depth's evaluations per pair solve, the solves that did not converge (they keep
-// the last iterate, docs/models.md), and the wall solves. Collective.
+// the last iterate, docs/models.md), the pair solves by their number of depth evaluations (a
+// histogram), and the wall solves. Collective.
 std::string shape_solves_json(const MpiDomain& domain) {
   const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
   const std::int64_t pairs = domain.sum(std::int64_t{st.pair_solves});
   const std::int64_t evaluations = domain.sum(std::int64_t{st.pair_iterations});
+  JsonObject bins;
+  for (int b = 0; b < SuperEllipseShape::kEvaluationBins; ++b)
+    bins.add_integer(SuperEllipseShape::kEvaluationBinLabels[b],
+                     domain.sum(std::int64_t{st.pair_evaluation_bins[b]}));
   JsonObject o;
   o.add_integer("pair_solves", pairs)
       .add_integer("pair_cold_starts", domain.sum(std::int64_t{st.pair_cold}))
       .add_number("depth_evaluations_per_pair_solve",
                   pairs > 0 ? static_cast<double>(evaluations) / static_cast<double>(pairs) : 0.0,
                   "%.4g")
+      .add("depth_evaluations_histogram", bins.inline_text())
       .add_integer("pair_unconverged", domain.sum(std::int64_t{st.pair_unconverged}))
       .add_integer("wall_solves", domain.sum(std::int64_t{st.wall_solves}))
       .add_integer("wall_unconverged", domain.sum(std::int64_t{st.wall_unconverged}));

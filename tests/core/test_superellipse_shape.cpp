@@ -9,7 +9,9 @@
 // Particles are built in code (no deck keys yet): ParticleSpec's semi_a, semi_b, exponent, angle.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
 #include <vector>
@@ -363,6 +365,24 @@ TEST(SuperEllipseShape, TwoEllipsesKeepMomentumAndAngularMomentumThroughAFrictio
   EXPECT_GT(std::abs(p.omega[0] - w0), 1.0) << "the impact changed the spins";
   EXPECT_LT(kinetic(sim), e0);
   EXPECT_EQ(SuperEllipseShape::stats().pair_unconverged, 0);
+  // The histogram of depth evaluations per pair solve holds every solve, and its bins bound the
+  // evaluations counted (each bin between its least and its most).
+  const SuperEllipseShape::Stats& st = SuperEllipseShape::stats();
+  constexpr std::array<std::int64_t, SuperEllipseShape::kEvaluationBins> least{1, 2, 3, 4,
+                                                                               5, 9, 17};
+  constexpr std::array<std::int64_t, SuperEllipseShape::kEvaluationBins> most{1, 2, 3, 4, 8, 16, 0};
+  std::int64_t solves = 0, low = 0, high = 0;
+  for (int b = 0; b < SuperEllipseShape::kEvaluationBins; ++b) {
+    const std::int64_t k = st.pair_evaluation_bins[b];
+    solves += k;
+    low += least[b] * k;
+    high += most[b] * k;
+    EXPECT_EQ(SuperEllipseShape::bin_of(static_cast<int>(least[b])), b);
+  }
+  EXPECT_EQ(solves, st.pair_solves);
+  EXPECT_EQ(st.pair_evaluation_bins[6], 0) << "no solve took 17 evaluations or more";
+  EXPECT_LE(low, st.pair_iterations);
+  EXPECT_GE(high, st.pair_iterations);
 }
 
 // Dropped tilted by 0.7 rad, it lands on its tip and rocks. Without rolling resistance the rocking

@@ -286,6 +286,17 @@ assert c['pair_solves'] > 0 and c['wall_solves'] > 0, c
 assert c['pair_unconverged'] == 0 and c['wall_unconverged'] == 0, c
 assert 0 < c['pair_cold_starts'] < c['pair_solves'], c
 assert 1.0 <= c['depth_evaluations_per_pair_solve'] <= 10.0, c
+# The histogram of evaluations per pair solve: every solve in one bin, and its mean (each bin
+# between its least and its most evaluations) holds the mean reported (printed to 4 digits).
+h = c['depth_evaluations_histogram']
+bins = {'1': (1, 1), '2': (2, 2), '3': (3, 3), '4': (4, 4), '5-8': (5, 8), '9-16': (9, 16),
+        '17+': (17, float('inf'))}
+assert list(h) == list(bins), h
+assert sum(h.values()) == c['pair_solves'], c
+least = sum(bins[k][0] * v for k, v in h.items()) / c['pair_solves']
+most = sum(bins[k][1] * v for k, v in h.items() if v > 0) / c['pair_solves']
+mean = c['depth_evaluations_per_pair_solve']
+assert least * (1 - 5e-4) <= mean <= most * (1 + 5e-4), (least, mean, most, h)
 " "$work/run1/run.json"
 check "1 and 2 ranks: the same snapshots, outlines included (h5compare.py)" \
   "$py" "$post/h5compare.py" "$work/run1/snapshots.h5" "$work/run2/snapshots.h5"

@@ -190,6 +190,8 @@ class Kernel final : public ContactKernel {
                   PairTotals& t);
   void pair_contacts(ParticleStore& p, PairList& pl, double dt, EvaluationTotals& tot);
   std::size_t gather_pairs(const ParticleStore& p, PairList& pl, std::size_t k0, std::size_t k1);
+  void gather_rotations_axes(const PairList& pl, std::size_t n);
+  void remember_axes(const PairList& pl, std::size_t n);
   void find_live(const PairList& pl, const WallPairList& wl);
   void release_ended(const ParticleStore& p, const Walls& walls, const PairList& pl,
                      const WallPairList& wl, double dt);
@@ -285,8 +287,24 @@ class Kernel final : public ContactKernel {
   // i (2k) and on j (2k + 1) (else never sized).
   Array<double> elastic_torque_records_;
   bool prefetch_scatter_ = false;  // scatter_pairs fetches the partners' lines ahead
-  // With kSemiAxes: each batch contact's a_i, b_i, n_i, a_j, b_j, n_j (else never sized).
-  std::array<Array<double>, 6> forms_;
+  // With kSemiAxes: each batch contact's a_i, b_i, n_i, a_j, b_j, n_j, then cos and sin of
+  // theta_i and theta_j, then the separating axis remembered for the pair (axes_; zero: none)
+  // (else never sized).
+  std::array<Array<double>, 12> forms_;
+  // With kSemiAxes: each body's cos and sin of its angle, taken once per force evaluation (the
+  // same functions of the same angle as the shape's own, so the same bits).
+  Array<double> rot_cos_, rot_sin_;
+  // With kSemiAxes: per pair-list entry, the separating axis the shape found at the entry's last
+  // evaluation apart (zero: none), with the pair's ids (an entry whose ids differ, after a
+  // rebuild, holds none). The shape uses it only to prove a pair apart faster, never for a
+  // contact, so nothing computed depends on it: it is neither migrated nor checkpointed.
+  struct AxisMemo {
+    std::int64_t id_i = -1, id_j = -1;
+    double x = 0.0, y = 0.0;
+  };
+  std::vector<AxisMemo> axes_;
+  // The batch's separating axes out of the shape (kSemiAxes).
+  std::array<Array<double>, 2> axis_out_;
   // Body i's form for the shape's wall (kSemiAxes).
   static SuperEllipse form_of(const ParticleStore& p, std::size_t i) {
     return {(*p.semi_a())[i], (*p.semi_b())[i], (*p.exponent())[i]};

@@ -20,8 +20,22 @@ void Kernel<Model, Shape>::prepare_pairs([[maybe_unused]] ParticleStore& p, Pair
   if constexpr (kSemiAxes) {
     if (!p.shaped())
       throw std::logic_error("a shape with semi-axes needs the store's shape fields");
-    if (forms_[0].size() < kChunk + kPackSize)
+    if (forms_[0].size() < kChunk + kPackSize) {
       for (Array<double>& f : forms_) f.resize(kChunk + kPackSize);
+      for (Array<double>& f : axis_out_) f.resize(kChunk + kPackSize);
+    }
+    const std::size_t bodies = p.size();
+    if (rot_cos_.size() < bodies) {
+      rot_cos_.resize(bodies);
+      rot_sin_.resize(bodies);
+    }
+    const double* theta = p.theta.data();
+    for (std::size_t i = 0; i < bodies; ++i) {
+      const double t = theta[i];  // one load: the two calls become one sincos
+      rot_cos_[i] = std::cos(t);
+      rot_sin_[i] = std::sin(t);
+    }
+    if (axes_.size() != pl.size()) axes_.resize(pl.size());
   }
   if (bi_.size() < kChunk + kPackSize) {
     bi_.resize(kChunk + kPackSize);
@@ -49,6 +63,7 @@ template <class Model, class Shape>
   const std::size_t n = gather_pairs(p, pl, k0, k1);
   Pack chunk_overlap(0.0);
   evaluate_pairs(n, dt, t.dissipated, t.elastic, chunk_overlap);
+  if constexpr (kSemiAxes) remember_axes(pl, n);
   scatter_pairs(p, pl, n);
   // The chunk's contacts, for release_ended next step (out of the scatter loop: a push_back
   // there cost 7 % on the waterfall).
@@ -146,6 +161,7 @@ std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList&
   }
   if (!vector_gather_ && n > 0) gather_inputs_scalar(cols, 0, n);
   if constexpr (kArmsApart) gather_frames_scalar(cols, 0, n);
+  if constexpr (kSemiAxes) gather_rotations_axes(pl, n);
   // In place: the committed histories of the chunk are read; the scatter rewrites the contacts'.
   if constexpr (kInPlace) std::fill(pl.history.data() + k0 * W, pl.history.data() + k1 * W, 0.0);
   if (n == 0) return 0;
@@ -158,6 +174,32 @@ std::size_t Kernel<Model, Shape>::gather_pairs(const ParticleStore& p, PairList&
       for (Array<double>& f : forms_) f[c] = f[n - 1];
   }
   return n;
+}
+
+// The batch's rotations (each body's, from prepare_pairs) and remembered separating axes.
+template <class Model, class Shape>
+void Kernel<Model, Shape>::gather_rotations_axes(const PairList& pl, std::size_t n) {
+  for (std::size_t c = 0; c < n; ++c) {
+    const std::int32_t i = bi_[c], j = bj_[c];
+    forms_[6][c] = rot_cos_[i];
+    forms_[7][c] = rot_sin_[i];
+    forms_[8][c] = rot_cos_[j];
+    forms_[9][c] = rot_sin_[j];
+    const auto k = static_cast<std::size_t>(b_.pair[c]);
+    const AxisMemo& m = axes_[k];
+    const bool same = m.id_i == pl.id_i[k] && m.id_j == pl.id_j[k];
+    forms_[10][c] = same ? m.x : 0.0;
+    forms_[11][c] = same ? m.y : 0.0;
+  }
+}
+
+// The separating axes the shape found for the batch's pairs apart (zero for the others).
+template <class Model, class Shape>
+void Kernel<Model, Shape>::remember_axes(const PairList& pl, std::size_t n) {
+  for (std::size_t c = 0; c < n; ++c) {
+    const auto k = static_cast<std::size_t>(b_.pair[c]);
+    axes_[k] = {pl.id_i[k], pl.id_j[k], axis_out_[0][c], axis_out_[1][c]};
+  }
 }
 
 // A pair's overlap, R*, reduced mass and (rolling models) reduced inertia about the contact point:
@@ -268,8 +310,18 @@ void Kernel<Model, Shape>::evaluate_pairs_apart(std::size_t n, double dt, EightL
       in.aj = load(forms_[3], c);
       in.bj = load(forms_[4], c);
       in.nj = load(forms_[5], c);
+      in.cos_i = load(forms_[6], c);
+      in.sin_i = load(forms_[7], c);
+      in.cos_j = load(forms_[8], c);
+      in.sin_j = load(forms_[9], c);
+      in.axis_x = load(forms_[10], c);
+      in.axis_y = load(forms_[11], c);
     }
     const PairContactT<Pack> g = Shape::pair(in, h_old, h_new);
+    if constexpr (kSemiAxes) {
+      store(g.axis_x, axis_out_[0], c);
+      store(g.axis_y, axis_out_[1], c);
+    }
     const PackMask touching = g.delta > zero;
     store(select(touching, load(b_.counted, c), zero), b_.counted, c);
     const Pack nx = g.nx, ny = g.ny;

@@ -37,19 +37,26 @@ struct PairContactT {
   T arm_i, arm_j;  // lengths of the contact arms along the normal (kArmsAlongNormal)
   // The arms as vectors, contact point minus each centre (shapes without kArmsAlongNormal).
   T aix{}, aiy{}, ajx{}, ajy{};
+  // A separating axis (unit, lab frame) of a pair found apart, for the next evaluation
+  // (PairInputT::axis_x, axis_y; shapes that remember one), else zero.
+  T axis_x{}, axis_y{};
 };
 
 // What the narrow phase of a shape without kArmsAlongNormal reads for two bodies i and j: the
 // centres' offset d = x_j - x_i (dist2 = |d|^2), their radii (bounding circles: the broad phase
 // and the gather's first test use them) and their angles.
 // A shape with semi-axes (kSemiAxes, the superellipse) reads each body's a, b and exponent n
-// too; other shapes leave them unset.
+// too, each body's cos and sin of its angle (taken once per body and evaluation), and the
+// separating axis the pair's last evaluation found (PairContactT::axis_x, axis_y; zero: none);
+// other shapes leave them unset.
 template <class T>
 struct PairInputT {
   T dx, dy, dist2;
   T ri, rj;
   T th_i, th_j;
   T ai{}, bi{}, ni{}, aj{}, bj{}, nj{};
+  T cos_i{}, sin_i{}, cos_j{}, sin_j{};
+  T axis_x{}, axis_y{};
 };
 
 // Whether a shape reads each body's semi-axes and exponent (PairInputT; its wall takes them).

@@ -13,6 +13,10 @@ namespace dem2d {
 namespace {
 
 Vec2 angle_cs(double theta) { return {std::cos(theta), std::sin(theta)}; }
+// A pose's rotation: the caller's (cos, sin) if given, else taken from its angle.
+Vec2 pose_rotation(const SuperPose& p) {
+  return p.rot.x != 0.0 || p.rot.y != 0.0 ? p.rot : angle_cs(p.theta);
+}
 // A lab-frame vector in the body frame of a body turned by the rotation (cos, sin) = cs, and back.
 Vec2 to_body(Vec2 v, Vec2 cs) { return rotate(v, Vec2{cs.x, -cs.y}); }
 Vec2 to_lab(Vec2 v, Vec2 cs) { return rotate(v, cs); }
@@ -558,25 +562,28 @@ struct ColdStart {
   Vec2 u;
   double overlap;
 };
+// Whether the lab unit vector u separates the two bodies, with gap: the gap along it (< 0:
+// apart), or the overlap of their support points along it. For n > 2 the support functions'
+// bound |a u_x| + |b u_y| (no pow) first: a negative gap there is already a separating axis
+// (then `gap` is the bound's).
+bool apart_along(const Body& bi, const Body& bj, Vec2 u, double& gap) {
+  const auto bound = [](const SuperEllipse& s, Vec2 v) {
+    return std::abs(s.a * v.x) + std::abs(s.b * v.y);
+  };
+  const Vec2 ui = to_body(u, bi.cs), uj = to_body(-u, bj.cs);
+  const double along = dot(u, bj.c - bi.c);
+  if (!(bi.s->n == 2.0 && bj.s->n == 2.0)) {
+    gap = bound(*bi.s, ui) + bound(*bj.s, uj) - along;
+    if (gap < 0.0) return true;
+  }
+  gap = dot(support(*bi.s, ui), ui) + dot(support(*bj.s, uj), uj) - along;
+  return gap < 0.0;
+}
 ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, double phi_dn, bool faces,
                              bool search) {
   const double turn = 2.0 * std::numbers::pi / kColdDirections;
   const Vec2 step{std::cos(turn), std::sin(turn)}, back{step.x, -step.y};
   const bool ellipses = bi.s->n == 2.0 && bj.s->n == 2.0;
-  const Vec2 d = bj.c - bi.c;
-  const auto bound = [](const SuperEllipse& s, Vec2 u) {
-    return std::abs(s.a * u.x) + std::abs(s.b * u.y);
-  };
-  const auto apart_along = [&](Vec2 u, double& gap) {
-    const Vec2 ui = to_body(u, bi.cs), uj = to_body(-u, bj.cs);
-    const double along = dot(u, d);
-    if (!ellipses) {
-      gap = bound(*bi.s, ui) + bound(*bj.s, uj) - along;
-      if (gap < 0.0) return true;
-    }
-    gap = dot(support(*bi.s, ui), ui) + dot(support(*bj.s, uj), uj) - along;
-    return gap < 0.0;
-  };
   // The face normals facing the other body: for flat-sided bodies (n > 2) the likeliest
   // separating axes (the separating axis of two rectangles is one of their face normals).
   if (faces && !ellipses)
@@ -589,7 +596,8 @@ ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, double phi
       Vec2 u = quarter == 0 ? e : quarter == 1 ? f : quarter == 2 ? -e : -f;
       if (b == &bj) u = -u, quarter += 2;
       double gap = 0.0;
-      if (apart_along(u, gap)) return {true, b->th + 0.5 * std::numbers::pi * quarter, u, gap};
+      if (apart_along(bi, bj, u, gap))
+        return {true, b->th + 0.5 * std::numbers::pi * quarter, u, gap};
     }
   ColdStart best{false, phi_dn, dn, 0.0};
   Vec2 fwd = dn, bwd = dn;
@@ -607,7 +615,7 @@ ColdStart separating_or_cold(const Body& bi, const Body& bj, Vec2 dn, double phi
     }
     const double phi = phi_dn + turn * k;
     double overlap = 0.0;
-    if (apart_along(u, overlap)) return {true, phi, u, overlap};
+    if (apart_along(bi, bj, u, overlap)) return {true, phi, u, overlap};
     if (m == 0 || overlap < best.overlap) best = {false, phi, u, overlap};
   }
   return best;
@@ -700,6 +708,15 @@ namespace {
 constexpr double kDeepOverlap = 0.25;
 constexpr int kDeepDirections = 64;
 
+// A pair found apart by the separating axis u (lab angle phi): the gap along it, converged.
+const SuperPairContact& apart(SuperPairContact& r, double gap, Vec2 u, double phi) {
+  r.delta = gap;
+  r.n = u;
+  r.angle = phi;
+  r.converged = true;
+  return r;
+}
+
 void deepest_minimum(const Body& bi, const Body& bj, const SolveOptions& opt, DepthSolve& depth) {
   std::array<double, kDeepDirections> g{};
   for (int k = 0; k < kDeepDirections; ++k)
@@ -733,41 +750,28 @@ SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, cons
   r.delta = Ri + Rj - dist;
   if (r.delta <= 0.0) return r;  // the bounding circles are apart
   r.candidate = true;
-  const Body bi{&si, pi.centre, angle_cs(pi.theta), pi.theta};
-  const Body bj{&sj, pj.centre, angle_cs(pj.theta), pj.theta};
+  const Body bi{&si, pi.centre, pose_rotation(pi), pi.theta};
+  const Body bj{&sj, pj.centre, pose_rotation(pj), pj.theta};
   const Vec2 dn = dist > 0.0 ? (1.0 / dist) * d : Vec2{1.0, 0.0};
   double phi0 = start.phi;
   if (!start.warm) {
+    double gap = 0.0;
+    const bool ellipses = si.n == 2.0 && sj.n == 2.0;
+    if (ellipses && (start.axis.x != 0.0 || start.axis.y != 0.0) &&
+        apart_along(bi, bj, start.axis, gap))
+      return apart(r, gap, start.axis, 0.0);
     const double phi_dn = std::atan2(dn.y, dn.x);
     const ColdStart faces = separating_or_cold(bi, bj, dn, phi_dn, true, false);
-    if (faces.apart) {
-      r.delta = faces.overlap;
-      r.n = faces.u;
-      r.angle = faces.phi;
-      r.converged = true;
-      return r;
-    }
+    if (faces.apart) return apart(r, faces.overlap, faces.u, faces.phi);
     // A few steps of the minimisation from the line of centres first: most pairs apart show a
     // negative overlap within them (the overlap falls towards the direction of closest approach).
     SolveOptions few = opt;
     few.max_iter = std::min(opt.max_iter, kApartProbe);
     const DepthSolve probe = solve_depth(bi, bj, phi_dn, std::numbers::pi / kColdDirections, few,
                                          /*stop_apart=*/true);
-    if (probe.e.g < 0.0) {
-      r.delta = probe.e.g;
-      r.n = probe.e.u;
-      r.angle = probe.e.phi;
-      r.converged = true;
-      return r;
-    }
+    if (probe.e.g < 0.0) return apart(r, probe.e.g, probe.e.u, probe.e.phi);
     const ColdStart cold = separating_or_cold(bi, bj, dn, phi_dn, false, true);
-    if (cold.apart) {
-      r.delta = cold.overlap;
-      r.n = cold.u;
-      r.angle = cold.phi;
-      r.converged = true;
-      return r;
-    }
+    if (cold.apart) return apart(r, cold.overlap, cold.u, cold.phi);
     phi0 = cold.phi;
   }
   DepthSolve depth =

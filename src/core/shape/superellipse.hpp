@@ -166,10 +166,13 @@ SuperWallContact contact_point(const SuperEllipse& s, Vec2 centre, double theta,
 // in the overlap (over the test's poses, overlaps 0.1-5 % of the size: median 3e-4 rad and 4e-4 of
 // the overlap, up to 6e-2 rad and 5e-2).
 
-// One body's place: centre of mass and angle (lab frame).
+// One body's place: centre of mass and angle (lab frame). rot: (cos theta, sin theta) when the
+// caller has them (the force kernel takes them once per body and evaluation), else zero: taken
+// here from theta (the same functions of the same angle, so the same bits either way).
 struct SuperPose {
   Vec2 centre{};
   double theta = 0.0;
+  Vec2 rot{};
 };
 
 struct SuperPairContact {
@@ -207,10 +210,20 @@ SuperPairContact contact_pair(const SuperEllipse& si, const SuperPose& pi, const
 // apart, with delta < 0 the gap along that axis (not the distance) and n along it, converged.
 // Overlapping bodies get contact_pair's contact (to the tolerance: its start may differ by
 // rounding). The midway fields are left unset.
+// start.axis (cold starts of two ellipses only; zero: none): a lab-frame unit vector that separated
+// the two bodies at an earlier step (the force kernel remembers the `n` of pairs found apart). It
+// is tried before everything else, by the same test as the search's directions; when it separates
+// them the pair is apart (delta: the gap along it, n: it, angle left 0), else the solve goes on
+// exactly as without it. It proves the bodies apart and nothing more. Not for n > 2: there the
+// solve below can end at a small positive overlap (up to 2.2e-6 m seen, for bodies of bounding
+// radius 0.1 m) on two near-parallel flat faces of bodies that an earlier step's axis still shows
+// apart (the minimisation's false convergence next to a face's middle, docs/performance.md), so the
+// axis would turn such contacts into pairs apart and change the results.
 struct DepthStart {
   bool warm = false;
   double phi = 0.0;
   double bound_i = 0.0, bound_j = 0.0;
+  Vec2 axis{};
 };
 SuperPairContact contact_depth(const SuperEllipse& si, const SuperPose& pi, const SuperEllipse& sj,
                                const SuperPose& pj, const DepthStart& start = {},

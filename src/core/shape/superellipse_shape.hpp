@@ -39,10 +39,17 @@
 // A pair whose bounding circles (the store's radii) are apart is apart; so is one for which the
 // cold start's coarse search (from the line of centres outwards) or an iterate of the depth's
 // minimisation finds a separating axis: the search stops there (most pairs of a charge whose
-// bounding circles overlap do not touch, and are never warm). Unconverged solves (the depth's
-// minimisation, the shell's iteration): counted in SuperEllipseShape::stats() (this process), with
-// the number of solves and the depth's evaluations (a kernel call's pair counts added once at its
-// end); an unconverged pair keeps the last iterate (an overlap along a direction near the normal).
+// bounding circles overlap do not touch, and are never warm). For two ellipses (n = 2) the kernel
+// remembers that axis for the pair (per pair-list entry, apart from the histories: a pair apart
+// has none) and hands it back at the next evaluation, where it is tried first (contact_depth,
+// DepthStart::axis): bodies move little in a step, so it mostly still separates them. It only
+// ever proves a pair apart, so the contacts found are the same with or without it (a rebuilt list
+// or a migrated pair loses it, which costs time only); for n > 2 it is not used (see
+// DepthStart). Each body's cos and sin of its angle come from the kernel too, taken once per body
+// and evaluation. Unconverged solves (the depth's minimisation, the shell's iteration): counted in
+// SuperEllipseShape::stats() (this process), with the number of solves, the depth's evaluations
+// and their histogram per solve (a kernel call's pair counts added once at its end); an
+// unconverged pair keeps the last iterate (an overlap along a direction near the normal).
 #pragma once
 
 #include <algorithm>
@@ -67,11 +74,25 @@ struct SuperEllipseShape {
         "warm start: the pair's normal angle less theta_i at its last step (walls: unused)"},
        {"r_star", "m", "R* of the contact's first step, kept for its life (0: a new contact)"}}};
 
+  // The pair solves' histogram of depth evaluations: bins of 1, 2, 3, 4, 5-8, 9-16 and 17 or more
+  // evaluations (kEvaluationBinLabels), bin_of(evaluations) the bin of a solve.
+  static constexpr int kEvaluationBins = 7;
+  static constexpr std::array<const char*, kEvaluationBins> kEvaluationBinLabels{
+      "1", "2", "3", "4", "5-8", "9-16", "17+"};
+  static constexpr int bin_of(int evaluations) {
+    return evaluations <= 4    ? std::max(evaluations, 1) - 1
+           : evaluations <= 8  ? 4
+           : evaluations <= 16 ? 5
+                               : 6;
+  }
+
   // Solves and their failures, since the start of the process (or the last reset).
   struct Stats {
     std::atomic<std::int64_t> pair_solves{0}, pair_unconverged{0}, pair_iterations{0};
     std::atomic<std::int64_t> pair_cold{0};  // pair solves from a cold start (new contacts)
     std::atomic<std::int64_t> wall_solves{0}, wall_unconverged{0};
+    // Pair solves by their depth evaluations (bin_of): the bins add up to pair_solves.
+    std::array<std::atomic<std::int64_t>, kEvaluationBins> pair_evaluation_bins{};
   };
   static Stats& stats() {
     static Stats s;
@@ -81,15 +102,19 @@ struct SuperEllipseShape {
     Stats& s = stats();
     s.pair_solves = s.pair_unconverged = s.pair_iterations = s.pair_cold = 0;
     s.wall_solves = s.wall_unconverged = 0;
+    for (std::atomic<std::int64_t>& b : s.pair_evaluation_bins) b = 0;
   }
   // A call's own counts, added to stats() once at its end.
   struct Tally {
     std::int64_t solves = 0, unconverged = 0, iterations = 0, cold = 0;
+    std::array<std::int64_t, kEvaluationBins> bins{};
     void flush() const {
       if (solves == 0) return;
       Stats& st = stats();
       st.pair_solves.fetch_add(solves, std::memory_order_relaxed);
       st.pair_iterations.fetch_add(iterations, std::memory_order_relaxed);
+      for (int b = 0; b < kEvaluationBins; ++b)
+        if (bins[b] > 0) st.pair_evaluation_bins[b].fetch_add(bins[b], std::memory_order_relaxed);
       if (unconverged > 0) st.pair_unconverged.fetch_add(unconverged, std::memory_order_relaxed);
       if (cold > 0) st.pair_cold.fetch_add(cold, std::memory_order_relaxed);
     }
@@ -100,11 +125,15 @@ struct SuperEllipseShape {
     return Disc::contact_inertia(m, r);
   }
 
-  // One pair of bodies: i at the origin, j at d = (dx, dy), bounding radii ri, rj. Lanes out of
-  // contact (bounding circles apart, or bodies apart) return delta <= 0 and zero history.
+  // One pair of bodies: i at the origin, j at d = (dx, dy), bounding radii ri, rj, angles th_i,
+  // th_j with their rotations (cos, sin) rot_i, rot_j (zero: taken from the angles). Lanes out
+  // of contact (bounding circles apart, or bodies apart) return delta <= 0 and zero history;
+  // bodies apart also their separating axis (axis_x, axis_y), which the caller may hand back as
+  // `axis` at the next evaluation (zero: none), a cold start's first try.
   static PairContactT<double> pair_one(double dx, double dy, double ri, double rj, double th_i,
-                                       double th_j, const SuperEllipse& si, const SuperEllipse& sj,
-                                       double h0, double h1, double& f0, double& f1, Tally& tally) {
+                                       double th_j, Vec2 rot_i, Vec2 rot_j, const SuperEllipse& si,
+                                       const SuperEllipse& sj, Vec2 axis, double h0, double h1,
+                                       double& f0, double& f1, Tally& tally) {
     PairContactT<double> g{};
     f0 = f1 = 0.0;
     g.r_eff = 1.0;
@@ -116,19 +145,25 @@ struct SuperEllipseShape {
       return g;
     }
     const bool warm = h1 > 0.0;  // a contact of the last step: its normal and R*
-    const DepthStart start{warm, h0 + th_i, ri, rj};
-    const SuperPairContact c =
-        contact_depth(si, SuperPose{{0.0, 0.0}, th_i}, sj, SuperPose{{dx, dy}, th_j}, start);
+    const DepthStart start{warm, h0 + th_i, ri, rj, axis};
+    const SuperPairContact c = contact_depth(si, SuperPose{{0.0, 0.0}, th_i, rot_i}, sj,
+                                             SuperPose{{dx, dy}, th_j, rot_j}, start);
     g.delta = c.delta;
     g.nx = c.n.x;
     g.ny = c.n.y;
     if (!(c.delta > 0.0)) {
-      if (!c.candidate) g.nx = 1.0;
+      if (!c.candidate) {
+        g.nx = 1.0;
+      } else if (c.delta < 0.0 && si.n == 2.0 && sj.n == 2.0) {  // c.n separates the ellipses
+        g.axis_x = c.n.x;
+        g.axis_y = c.n.y;
+      }
       return g;
     }
     ++tally.solves;
     tally.cold += warm ? 0 : 1;
     tally.iterations += c.depth_iterations;
+    ++tally.bins[bin_of(c.depth_iterations)];
     if (!c.converged) ++tally.unconverged;
     g.r_eff = warm ? h1 : c.rho_i * c.rho_j / (c.rho_i + c.rho_j);
     g.aix = c.arm_i.x;
@@ -148,8 +183,9 @@ struct SuperEllipseShape {
     Tally tally;
     if constexpr (std::is_same_v<T, double>) {
       const PairContactT<double> g =
-          pair_one(in.dx, in.dy, in.ri, in.rj, in.th_i, in.th_j, {in.ai, in.bi, in.ni},
-                   {in.aj, in.bj, in.nj}, old[0], old[1], fresh[0], fresh[1], tally);
+          pair_one(in.dx, in.dy, in.ri, in.rj, in.th_i, in.th_j, {in.cos_i, in.sin_i},
+                   {in.cos_j, in.sin_j}, {in.ai, in.bi, in.ni}, {in.aj, in.bj, in.nj},
+                   {in.axis_x, in.axis_y}, old[0], old[1], fresh[0], fresh[1], tally);
       tally.flush();
       return g;
     } else {
@@ -169,8 +205,9 @@ struct SuperEllipseShape {
           continue;
         }
         g[l] = pair_one(in.dx[l], in.dy[l], in.ri[l], in.rj[l], in.th_i[l], in.th_j[l],
-                        {in.ai[l], in.bi[l], in.ni[l]}, {in.aj[l], in.bj[l], in.nj[l]}, old[0][l],
-                        old[1][l], f0[l], f1[l], tally);
+                        {in.cos_i[l], in.sin_i[l]}, {in.cos_j[l], in.sin_j[l]},
+                        {in.ai[l], in.bi[l], in.ni[l]}, {in.aj[l], in.bj[l], in.nj[l]},
+                        {in.axis_x[l], in.axis_y[l]}, old[0][l], old[1][l], f0[l], f1[l], tally);
       }
       tally.flush();
       const auto col = [&](auto field) { return T([&](auto l) { return g[l].*field; }); };
@@ -185,6 +222,8 @@ struct SuperEllipseShape {
       out.aiy = col(&PairContactT<double>::aiy);
       out.ajx = col(&PairContactT<double>::ajx);
       out.ajy = col(&PairContactT<double>::ajy);
+      out.axis_x = col(&PairContactT<double>::axis_x);
+      out.axis_y = col(&PairContactT<double>::axis_y);
       fresh[0] = T([&](auto l) { return f0[l]; });
       fresh[1] = T([&](auto l) { return f1[l]; });
       return out;
