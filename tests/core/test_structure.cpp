@@ -194,5 +194,253 @@ TEST(FiniteElementCantilever, AClampedLifterBlockBendsAsTimoshenkosBeam) {
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Lame's thick ring: inner radius a, outer b clamped (u_r(b) = 0), pressure p inside. Plane
+// strain: u_r = A r + B / r, sigma_r = 2 (lambda + mu) A - 2 mu B / r^2,
+// sigma_theta = 2 (lambda + mu) A + 2 mu B / r^2, with B = -A b^2 and sigma_r(a) = -p.
+struct LameRing {
+  double a = 1.0, b = 1.2, p = 1e6;
+  ElasticMaterial m = kSteel;
+  double lambda() const {
+    const double nu = m.poisson_ratio;
+    return m.youngs_modulus * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  }
+  double big_a() const {
+    const double mu = shear_modulus(m);
+    return -p / (2.0 * (lambda() + mu) + 2.0 * mu * b * b / (a * a));
+  }
+  double u(double r) const { return big_a() * (r - b * b / r); }
+  double sigma_r(double r) const {
+    return 2.0 * (lambda() + shear_modulus(m)) * big_a() +
+           2.0 * shear_modulus(m) * big_a() * b * b / (r * r);
+  }
+  double sigma_theta(double r) const {
+    return 2.0 * (lambda() + shear_modulus(m)) * big_a() -
+           2.0 * shear_modulus(m) * big_a() * b * b / (r * r);
+  }
+};
+
+TEST(FiniteElementLame, AClampedThickRingUnderInternalPressureConverges) {
+  const LameRing ring;
+  std::vector<double> u_error;
+  for (const int nr : {1, 2, 4}) {
+    const ShellMeshSpec spec{ring.b - ring.a, nr, 2.0 * (ring.b - ring.a) / nr, true};
+    const FeModel model(shell_mesh(ring.a, {}, spec), ring.m);
+    FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model.dofs()));
+    add_inner_pressure(model.mesh(), ring.p, f);
+    const FeVector u = model.solve(f);
+    const FeStress s = model.stress(u);
+    double du = 0.0, dsr = 0.0, dst = 0.0;
+    for (std::size_t n = 0; n < model.mesh().nodes.size(); ++n) {
+      const Vec2 x = model.mesh().nodes[n];
+      const double r = norm(x);
+      const Vec2 e = x * (1.0 / r);
+      du = std::max(du, std::abs(u(2 * n) * e.x + u(2 * n + 1) * e.y - ring.u(r)));
+      const PlaneStress& q = s.nodal[n];
+      const double sr = q.xx * e.x * e.x + q.yy * e.y * e.y + 2.0 * q.xy * e.x * e.y;
+      const double st = q.xx * e.y * e.y + q.yy * e.x * e.x - 2.0 * q.xy * e.x * e.y;
+      dsr = std::max(dsr, std::abs(sr - ring.sigma_r(r)));
+      dst = std::max(dst, std::abs(st - ring.sigma_theta(r)));
+    }
+    u_error.push_back(du / ring.u(ring.a));
+    std::printf(
+        "Lame ring n_r = %d (%zu elements): u_r error %.3e, sigma_r %.3e, sigma_theta %.3e "
+        "(of p)\n",
+        nr, model.mesh().elements.size(), u_error.back(), dsr / ring.p, dst / ring.p);
+    EXPECT_LT(dsr / ring.p, 0.02);
+    EXPECT_LT(dst / ring.p, 0.02);
+  }
+  EXPECT_LT(u_error.back(), 1e-5);
+  for (std::size_t k = 1; k < u_error.size(); ++k)
+    EXPECT_GT(std::log2(u_error[k - 1] / u_error[k]), 2.8);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The drum: radius 1 m, a shell 50 mm thick, 8 bars 150 mm high and 50 mm wide.
+DrumSpec eight_lifter_drum(double width = 0.05) {
+  DrumSpec d;
+  d.present = true;
+  d.radius = 1.0;
+  d.angle = 0.0;
+  d.material = "steel";
+  LifterSpec l;
+  l.count = 8;
+  l.height = 0.15;
+  l.width = width;
+  l.angle = 0.1;
+  d.lifters.push_back(l);
+  return d;
+}
+const ShellMeshSpec kShell{0.05, 2, 0.0125, true};
+
+TEST(ShellMesh, BarsStandOnRingNodesAndTheMeshHoldsTheDrumsArea) {
+  const DrumGeometry drum(eight_lifter_drum());
+  const FeMesh mesh = shell_mesh(drum, kShell);
+  const auto has_node = [&](Vec2 p) {
+    double d = 1e300;
+    for (const Vec2 x : mesh.nodes) d = std::min(d, norm(x - p));
+    return d;
+  };
+  double corner = 0.0;
+  for (const DrumGeometry::Bar& b : drum.bars())
+    for (const Vec2 c : b.corner) corner = std::max(corner, has_node(c));
+  EXPECT_LT(corner, 1e-14);
+  // The area: the ring, plus per bar the rectangle from its top to the chord of its feet and
+  // the circular segment between the chord and the circle.
+  const double r = drum.radius(), t = kShell.thickness;
+  const DrumGeometry::Bar& b = drum.bars().front();
+  const double half = std::asin(b.half_width / r),
+               foot = std::sqrt(r * r - b.half_width * b.half_width);
+  const double bar =
+      2.0 * b.half_width * (foot - b.top) + r * r * (half - std::sin(half) * std::cos(half));
+  const double area = kPi * ((r + t) * (r + t) - r * r) + 8.0 * bar;
+  const FeModel model(mesh, {1.0, 0.3, 1.0});
+  double mass = 0.0;  // the x-x block of the consistent mass, summed: density 1 times the area
+  for (int c = 0; c < model.mass().outerSize(); c += 2)
+    for (FeSparse::InnerIterator it(model.mass(), c); it; ++it)
+      if (it.row() % 2 == 0) mass += it.value();
+  std::printf("drum mesh: %zu nodes, %zu elements; area %.12f, closed form %.12f (%.1e)\n",
+              mesh.nodes.size(), mesh.elements.size(), mass, area, mass / area - 1.0);
+  EXPECT_NEAR(mass / area, 1.0, 1e-7);
+  EXPECT_EQ(mesh.bars.size(), 8u);
+}
+
+TEST(ShellMesh, APolygonalShellAndOverlappingBarsAreRefused) {
+  DrumSpec polygon = eight_lifter_drum();
+  polygon.sides = 12;
+  EXPECT_THROW(shell_mesh(DrumGeometry(polygon), kShell), std::invalid_argument);
+  std::vector<FeBar> bars(2);
+  bars[0] = {0.0, 0.05, 0.8, {}, {}, -1};
+  bars[1] = {0.06, 0.05, 0.8, {}, {}, -1};
+  EXPECT_THROW(shell_mesh(1.0, bars, kShell), std::invalid_argument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Loads.
+
+TEST(ShellLoads, APointForceGivesNodalLoadsWithItsSumAndItsMomentAndTheSupportsCarryIt) {
+  const DrumGeometry drum(eight_lifter_drum());
+  const FeModel model(shell_mesh(drum, kShell), kSteel);
+  const FeMesh& mesh = model.mesh();
+  const auto n = static_cast<Eigen::Index>(model.dofs());
+  const auto sum_and_moment = [&](const FeVector& f, Vec2& sum, double& moment) {
+    sum = {};
+    moment = 0.0;
+    for (std::size_t i = 0; i < mesh.nodes.size(); ++i) {
+      const Vec2 fi{f(2 * i), f(2 * i + 1)};
+      sum += fi;
+      moment += cross(mesh.nodes[i], fi);
+    }
+  };
+  // A weight resting on the shell (on the circle, between bars) and a push on a bar's face.
+  const double theta = -0.5 * kPi + 0.3;
+  const Vec2 on_shell{std::cos(theta), std::sin(theta)};
+  const DrumGeometry::Bar& bar = drum.bars()[2];
+  const Vec2 on_face = 0.6 * bar.corner[2] + 0.4 * bar.corner[3];
+  for (const auto& [p, force] :
+       {std::pair{on_shell, Vec2{0.0, -2500.0}}, std::pair{on_face, Vec2{-1200.0, 700.0}}}) {
+    FeVector f = FeVector::Zero(n);
+    add_point_force(mesh, p, force, f);
+    Vec2 sum;
+    double moment = 0.0;
+    sum_and_moment(f, sum, moment);
+    const double scale = norm(force) * norm(p);
+    std::printf("point force at (%.3f, %.3f): sum error %.1e N, moment error %.1e (of |F||p|)\n",
+                p.x, p.y, norm(sum - force), std::abs(moment - cross(p, force)) / scale);
+    EXPECT_LT(norm(sum - force), 1e-15 * norm(force) * 4.0);
+    // The arc's quadratic edges lie within ~1e-9 m of the circle for 12.5 mm elements.
+    EXPECT_LT(std::abs(moment - cross(p, force)) / scale, 1e-9);
+    const FeVector u = model.solve(f);
+    const FeVector r = model.reactions(u, f);
+    Vec2 reaction;
+    double reaction_moment = 0.0;
+    sum_and_moment(r, reaction, reaction_moment);
+    double free_residual = 0.0;
+    for (const int i : model.free_dofs()) free_residual = std::max(free_residual, std::abs(r(i)));
+    std::printf("  supports: sum + F = %.1e N, moment + M = %.1e N m, free-dof residual %.1e N\n",
+                norm(reaction + force), std::abs(reaction_moment + moment), free_residual);
+    EXPECT_LT(norm(reaction + force), 1e-9 * norm(force));
+    EXPECT_LT(std::abs(reaction_moment + moment), 1e-9 * scale);
+  }
+}
+
+TEST(ShellLoads, WallLoadRecordsLandOnTheirElementsInTheDrumFrame) {
+  const DrumGeometry drum(eight_lifter_drum());
+  const FeMesh mesh = shell_mesh(drum, kShell);
+  // The walls' elements: the circle, three per bar in order, and a [[wall]] segment.
+  std::vector<WallElement> elements(1 + 3 * drum.bars().size() + 1);
+  elements[0].kind = WallKind::kCircle;
+  elements[0].part = WallPart::kShell;
+  for (std::size_t k = 1; k + 1 < elements.size(); ++k) elements[k].part = WallPart::kLifter;
+  elements.back().part = WallPart::kWall;
+  const WallLoadMap map(mesh, elements);
+  const double angle = 0.7, depth = 0.25;
+  const Vec2 centre{0.3, -0.2};
+  const auto lab = [&](Vec2 drum_point) { return centre + rotate(drum_point, angle); };
+  const DrumGeometry::Bar& bar = drum.bars()[5];
+  const Vec2 on_face = 0.3 * bar.corner[2] + 0.7 * bar.corner[3];  // bar 5's lifting face
+  const Vec2 on_top = 0.5 * bar.corner[1] + 0.5 * bar.corner[2];
+  const Vec2 on_shell{std::cos(-1.9), std::sin(-1.9)};
+  std::vector<WallLoad> loads(4);
+  loads[0] = {1 + 3 * 5 + 2, 0, lab(on_face), {30.0, -5.0}, 0.0, {}};
+  loads[1] = {0, 1, lab(on_shell), {-3.0, 40.0}, 0.0, {}};
+  loads[2] = {1 + 3 * 5 + 1, 2, lab(on_top), {1.0, 2.0}, 0.0, {}};
+  loads[3] = {static_cast<std::int32_t>(elements.size() - 1), 3, {5.0, 5.0}, {9.0, 9.0}, 0.0, {}};
+  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(mesh.dofs()));
+  EXPECT_EQ(map.add(loads, angle, centre, depth, f), 3u);
+  // The same forces placed directly in the drum frame: the wall receives -force / depth.
+  FeVector g = FeVector::Zero(f.size());
+  const std::array<Vec2, 3> at{on_face, on_shell, on_top};
+  Vec2 total{};
+  for (int k = 0; k < 3; ++k) {
+    const Vec2 force = rotate(loads[static_cast<std::size_t>(k)].force, -angle) * (-1.0 / depth);
+    add_point_force(mesh, at[static_cast<std::size_t>(k)], force, g);
+    total += force;
+  }
+  Vec2 sum{};
+  for (std::size_t i = 0; i < mesh.nodes.size(); ++i) sum += Vec2{f(2 * i), f(2 * i + 1)};
+  std::printf("wall loads: |f - direct| = %.1e, sum error %.1e N/m\n", (f - g).norm(),
+              norm(sum - total));
+  EXPECT_LT((f - g).norm(), 1e-12 * g.norm());
+  EXPECT_LT(norm(sum - total), 1e-12 * norm(total));
+}
+
+// ---------------------------------------------------------------------------------------------
+// A whole drum: a load on one bar's lifting face, at its top, pushing against the rotation.
+
+TEST(ShellDrum, ALoadOnALiftingFaceBendsThatBarAsACantileverOnAnElasticFoot) {
+  const DrumGeometry drum(eight_lifter_drum());
+  const FeModel model(shell_mesh(drum, kShell), kSteel);
+  const std::size_t loaded = 3;
+  const DrumGeometry::Bar& bar = drum.bars()[loaded];
+  const Vec2 radial{std::cos(bar.phi), std::sin(bar.phi)};
+  const double p = 1e4;  // N/m
+  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model.dofs()));
+  add_point_force(model.mesh(), bar.corner[2], -p * perp(radial), f);
+  const FeVector u = model.solve(f);
+  const FeStress s = model.stress(u);
+  const BarResponse r = model.bar_response(loaded, u, s);
+  // The cantilever from the shell's surface (its mid-width) to the top face.
+  const double length = drum.radius() - bar.top, w = 2.0 * bar.half_width;
+  const double inertia = w * w * w / 12.0;
+  const double beam =
+      p * length * length * length / (3.0 * plane_strain_modulus(kSteel) * inertia) +
+      p * length / (5.0 / 6.0 * shear_modulus(kSteel) * w);
+  // The root bending stress of the beam, 6 P L / w^2, for the peak von Mises' order.
+  const double root = 6.0 * p * length / (w * w);
+  std::printf(
+      "drum bar: tip %.4e m (side), %.2e m (radial); cantilever %.4e m; ratio %.3f; peak "
+      "von Mises %.3e Pa, beam root stress %.3e Pa\n",
+      r.tip_side, r.tip_radial, beam, -r.tip_side / beam, r.peak_von_mises, root);
+  EXPECT_LT(r.tip_side, 0.0);          // along the load
+  EXPECT_GT(-r.tip_side / beam, 1.1);  // the foot is not rigid: the shell adds compliance
+  EXPECT_LT(-r.tip_side / beam, 1.5);
+  // The other bars barely move.
+  for (std::size_t b = 0; b < model.mesh().bars.size(); ++b) {
+    if (b == loaded) continue;
+    EXPECT_LT(std::abs(model.bar_response(b, u, s).tip_side), 0.01 * beam);
+  }
+}
+
 }  // namespace
 }  // namespace dem2d
