@@ -7,8 +7,8 @@
 // unity), so the nodal loads sum to F up to the round-off of three additions, and sum_a N_a(xi)
 // x_a = x(xi) is the point itself, so their moment about the centre is x(xi) x F: the force's
 // moment, where x(xi) is the point of the edge nearest to the given one (on a straight edge the
-// point itself; on the shell's circle the quadratic arc lies within about (h / R)^3 h / 100 of
-// the circle for elements of length h).
+// point itself; the quadratic arc of a ring element spanning an angle 2 theta departs from the
+// circle by at most R theta^4 / 32, 5e-11 m for 12.5 mm elements on a 1 m drum).
 //
 // The DEM's wall loads (core/geometry/wall_loads.hpp) are forces of 3D spheres on the walls:
 // the FE model carries per metre of depth, so a record's load on the shell is
