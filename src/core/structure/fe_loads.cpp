@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "core/structure/q9_element.hpp"
@@ -98,16 +99,21 @@ void add_inner_pressure(const FeMesh& mesh, double pressure, FeVector& f) {
 }
 
 WallLoadMap::WallLoadMap(const FeMesh& mesh, std::span<const WallElement> elements)
-    : mesh_(&mesh), targets_(elements.size()) {
-  std::vector<std::size_t> ring;
-  for (std::size_t e = 0; e < mesh.loaded_edges.size(); ++e)
-    if (mesh.loaded_edges[e].bar < 0) ring.push_back(e);
+    : mesh_(&mesh), targets_(elements.size()), shell_(elements.size(), 0) {
+  for (std::size_t e = 0; e < mesh.loaded_edges.size(); ++e) {
+    if (mesh.loaded_edges[e].bar >= 0) continue;
+    const Vec2 a = mesh.nodes[static_cast<std::size_t>(mesh.loaded_edges[e].node[0])];
+    double angle = std::atan2(a.y, a.x);
+    if (angle < 0.0) angle += 2.0 * std::numbers::pi;
+    ring_.emplace_back(angle, e);
+  }
+  std::sort(ring_.begin(), ring_.end());
   std::size_t lifter = 0;
   for (std::size_t w = 0; w < elements.size(); ++w) {
     if (elements[w].part == WallPart::kShell) {
       if (elements[w].kind != WallKind::kCircle)
         throw std::invalid_argument("WallLoadMap: only the circular shell is meshed");
-      targets_[w] = ring;
+      shell_[w] = 1;
     } else if (elements[w].part == WallPart::kLifter) {
       const int bar = static_cast<int>(lifter / 3), face = static_cast<int>(lifter % 3);
       for (std::size_t e = 0; e < mesh.loaded_edges.size(); ++e)
@@ -120,16 +126,34 @@ WallLoadMap::WallLoadMap(const FeMesh& mesh, std::span<const WallElement> elemen
     throw std::invalid_argument("WallLoadMap: the walls do not hold three elements per mesh bar");
 }
 
+std::vector<std::size_t> WallLoadMap::ring_candidates(Vec2 p) const {
+  if (ring_.size() <= 3) {
+    std::vector<std::size_t> all;
+    for (const auto& r : ring_) all.push_back(r.second);
+    return all;
+  }
+  double angle = std::atan2(p.y, p.x);
+  if (angle < 0.0) angle += 2.0 * std::numbers::pi;
+  const auto after =
+      std::upper_bound(ring_.begin(), ring_.end(), std::pair{angle, std::size_t{0}},
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+  const std::size_t n = ring_.size();
+  const std::size_t k =
+      after == ring_.begin() ? n - 1 : static_cast<std::size_t>(after - ring_.begin()) - 1;
+  return {ring_[(k + n - 1) % n].second, ring_[k].second, ring_[(k + 1) % n].second};
+}
+
 std::size_t WallLoadMap::add(std::span<const WallLoad> loads, double drum_angle, Vec2 centre,
                              double depth, FeVector& f) const {
   if (!(depth > 0.0)) throw std::invalid_argument("WallLoadMap: the depth must be positive");
   std::size_t placed = 0;
   for (const WallLoad& l : loads) {
-    const std::vector<std::size_t>& edges = targets_.at(static_cast<std::size_t>(l.element));
-    if (edges.empty()) continue;
+    const auto w = static_cast<std::size_t>(l.element);
+    if (!shell_.at(w) && targets_[w].empty()) continue;
     const Vec2 p = rotate(l.point - centre, -drum_angle);
     const Vec2 force = rotate(l.force, -drum_angle) * (-1.0 / depth);
-    const EdgePoint at = nearest_edge_point(*mesh_, edges, p);
+    const EdgePoint at = shell_[w] ? nearest_edge_point(*mesh_, ring_candidates(p), p)
+                                   : nearest_edge_point(*mesh_, targets_[w], p);
     add_point_force(mesh_->loaded_edges[at.edge], at.xi, force, f);
     ++placed;
   }

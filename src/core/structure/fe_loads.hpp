@@ -17,7 +17,8 @@
 // (WallPart::kLifter; the walls hold three per bar, consecutive, in the bars' order, faces as
 // DrumGeometry::Bar::corner runs) goes to that bar's face, the shell's circle to the nearest
 // edge of the ring's exposed inner surface; [[wall]] segments are not part of the drum and are
-// skipped. Points are taken from the lab frame to the drum frame by the drum's current angle:
+// skipped (the ring's edges are found by the point's angle, a bar face's among its few edges by
+// distance). Points are taken from the lab frame to the drum frame by the drum's current angle:
 // x_drum = rotate(x_lab - centre, -angle), and so are forces. The records are added in the
 // order given: pass them sorted by (particle id, element) for sums that do not depend on the
 // rank count.
@@ -26,6 +27,7 @@
 #include <cstddef>
 #include <functional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/geometry/wall_loads.hpp"
@@ -68,9 +70,16 @@ class WallLoadMap {
   std::size_t add(std::span<const WallLoad> loads, double drum_angle, Vec2 centre, double depth,
                   FeVector& f) const;
 
+  // The ring's exposed edges near drum-frame point p: the edge whose angular span holds p's
+  // angle (or the next one counter-clockwise, when p stands over a bar's foot) and its two
+  // neighbours.
+  std::vector<std::size_t> ring_candidates(Vec2 p) const;
+
  private:
   const FeMesh* mesh_;
-  std::vector<std::vector<std::size_t>> targets_;  // per wall element its candidate edges
+  std::vector<std::vector<std::size_t>> targets_;     // per wall element its bar face's edges
+  std::vector<char> shell_;                           // per wall element: the shell's circle
+  std::vector<std::pair<double, std::size_t>> ring_;  // exposed ring edges by start angle
 };
 
 }  // namespace dem2d
