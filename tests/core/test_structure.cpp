@@ -456,6 +456,41 @@ TEST(ShellDrum, ALoadOnALiftingFaceBendsThatBarAsACantileverOnAnElasticFoot) {
   EXPECT_LT(r.tip_side, 0.0);          // along the load
   EXPECT_GT(-r.tip_side / beam, 1.1);  // the foot is not rigid: the shell adds compliance
   EXPECT_LT(-r.tip_side / beam, 1.5);
+  // Half way up the bar the bending stress along it is the beam's, +-6 P a / w^2 on the faces
+  // at a distance a from the load (the lifting face, +w/2, on the convex side: in tension);
+  // the moment there is set by the load alone, whatever the foot does.
+  const double mid = bar.top + 0.5 * (dot(bar.corner[3], radial) - bar.top);
+  for (const double lateral : {-bar.half_width, bar.half_width}) {
+    std::size_t best = 0;
+    double best_d = 1e300;
+    for (std::size_t i = 0; i < model.mesh().nodes.size(); ++i) {
+      const Vec2 x = model.mesh().nodes[i];
+      const double d = std::abs(dot(x, perp(radial)) - lateral) + std::abs(dot(x, radial) - mid);
+      if (d < best_d) best_d = d, best = i;
+    }
+    const Vec2 x = model.mesh().nodes[best];
+    const PlaneStress& q = s.nodal[best];
+    const double along =
+        q.xx * radial.x * radial.x + q.yy * radial.y * radial.y + 2.0 * q.xy * radial.x * radial.y;
+    const double expected =
+        (lateral > 0.0 ? 1.0 : -1.0) * 6.0 * p * (dot(x, radial) - bar.top) / (w * w);
+    std::printf("  bending stress at mid-height, lateral %+.3f m: %.4e Pa, beam %.4e Pa\n", lateral,
+                along, expected);
+    EXPECT_LT(best_d, 1e-12);
+    EXPECT_NEAR(along / expected, 1.0, 0.02);
+  }
+  // The same bar with the whole ring held fixed (the bar clamped on its foot arc) bends as the
+  // cantilever: the shell's compliance is what the first ratio adds.
+  FeMesh rigid_ring = model.mesh();
+  for (std::size_t e = 0; e < rigid_ring.elements.size(); ++e)
+    if (rigid_ring.element_bar[e] < 0)
+      for (const int n : rigid_ring.elements[e]) rigid_ring.fix_node(n);
+  const FeModel clamped(rigid_ring, kSteel);
+  const FeVector uc = clamped.solve(f);
+  const double clamped_tip = clamped.bar_response(loaded, uc, clamped.stress(uc)).tip_side;
+  std::printf("  the bar clamped on a rigid ring: tip %.4e m, ratio to the cantilever %.3f\n",
+              clamped_tip, -clamped_tip / beam);
+  EXPECT_NEAR(-clamped_tip / beam, 1.0, 0.03);
   // The other bars barely move.
   for (std::size_t b = 0; b < model.mesh().bars.size(); ++b) {
     if (b == loaded) continue;

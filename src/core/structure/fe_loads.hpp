@@ -62,7 +62,8 @@ void add_inner_pressure(const FeMesh& mesh, double pressure, FeVector& f);
 class WallLoadMap {
  public:
   // `elements`: Walls::elements(). The mesh's bars must be the drum's, in order (shell_mesh of
-  // the same DrumGeometry), three lifter elements per bar.
+  // the same DrumGeometry), three lifter elements per bar. The map keeps a reference to `mesh`
+  // (FeModel::mesh(), say), which must outlive it.
   WallLoadMap(const FeMesh& mesh, std::span<const WallElement> elements);
   // Adds each record's load on the walls (-force / depth, N/m) to f, in the records' order.
   // `drum_angle`: the drum's current angle (Walls::drum_angle()); `centre`: the drum's centre,

@@ -16,17 +16,20 @@ constexpr std::array<int, 9> kEta{0, 0, 2, 2, 0, 1, 2, 1, 1};
 double cartesian_derivatives(const Q9Nodes& x, double xi, double eta, std::array<Vec2, 9>& dn) {
   const std::array<Vec2, 9> dr = q9_shape_derivatives(xi, eta);
   double j11 = 0.0, j12 = 0.0, j21 = 0.0, j22 = 0.0;  // d(x, y) / d(xi, eta)
+  // Every product rounded on its own (rounded(), core/base/vec2.hpp): the vectorizer would fuse
+  // these 2 x 2 sums into multiply-add-subtract instructions despite -ffp-contract=off.
   for (int a = 0; a < 9; ++a) {
-    j11 += dr[a].x * x[a].x;
-    j12 += dr[a].x * x[a].y;
-    j21 += dr[a].y * x[a].x;
-    j22 += dr[a].y * x[a].y;
+    j11 += rounded(dr[a].x * x[a].x);
+    j12 += rounded(dr[a].x * x[a].y);
+    j21 += rounded(dr[a].y * x[a].x);
+    j22 += rounded(dr[a].y * x[a].y);
   }
-  const double det = j11 * j22 - j12 * j21;
+  const double det = rounded(j11 * j22) - rounded(j12 * j21);
   if (!(det > 0.0))
     throw std::runtime_error("q9 element: non-positive Jacobian (a folded or clockwise element)");
   for (int a = 0; a < 9; ++a)
-    dn[a] = {(j22 * dr[a].x - j12 * dr[a].y) / det, (-j21 * dr[a].x + j11 * dr[a].y) / det};
+    dn[a] = {(rounded(j22 * dr[a].x) - rounded(j12 * dr[a].y)) / det,
+             (rounded(j11 * dr[a].y) - rounded(j21 * dr[a].x)) / det};
   return det;
 }
 
