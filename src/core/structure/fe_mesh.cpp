@@ -74,6 +74,7 @@ void add_bar(FeMesh& mesh, FeBar bar, int bar_index, const std::vector<int>& foo
     for (int k = 1; k <= 2 * nh; ++k) {
       const double u = static_cast<double>(k) / (2 * nh);
       grid[static_cast<std::size_t>(k * columns + i)] = static_cast<int>(mesh.nodes.size());
+      bar.nodes.push_back(static_cast<int>(mesh.nodes.size()));
       mesh.nodes.push_back((1.0 - u) * b + u * t);
     }
   }
@@ -95,6 +96,7 @@ void add_bar(FeMesh& mesh, FeBar bar, int bar_index, const std::vector<int>& foo
         {{at(columns - 1, k), at(columns - 1, k - 1), at(columns - 1, k - 2)}, bar_index, 2});
   for (int i = 0; i < columns; ++i) bar.top_nodes.push_back(at(i, 2 * nh));
   bar.tip_node = at(columns / 2, 2 * nh);
+  bar.foot = dot(mesh.nodes[static_cast<std::size_t>(foot[0])], radial);
   mesh.bars[static_cast<std::size_t>(bar_index)] = std::move(bar);
 }
 

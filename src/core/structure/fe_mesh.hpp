@@ -44,6 +44,8 @@ struct FeBar {
   std::vector<int> elements;   // into FeMesh::elements
   std::vector<int> top_nodes;  // the top face's nodes, from lateral -w/2 to +w/2
   int tip_node = -1;           // the top face's middle node (lateral offset 0)
+  std::vector<int> nodes;      // its own nodes: all but the feet (those are the ring's)
+  double foot = 0.0;           // the feet's distance from the centre along the bar's axis
 };
 
 struct FeMesh {

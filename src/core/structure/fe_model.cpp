@@ -146,4 +146,22 @@ BarResponse FeModel::bar_response(std::size_t bar, const FeVector& u, const FeSt
   return r;
 }
 
+BarRoot FeModel::bar_root(std::size_t bar, const FeVector& f) const {
+  const FeBar& b = mesh_.bars.at(bar);
+  const Vec2 radial{std::cos(b.phi), std::sin(b.phi)};
+  const Vec2 centre = b.foot * radial;
+  Vec2 sum{};
+  BarRoot r;
+  for (const int n : b.nodes) {
+    const Vec2 fn{f(2 * n), f(2 * n + 1)};
+    sum += fn;
+    r.moment += cross(mesh_.nodes[static_cast<std::size_t>(n)] - centre, fn);
+  }
+  r.axial = -dot(sum, radial);
+  r.shear = dot(sum, perp(radial));
+  const double w = 2.0 * b.half_width;
+  r.nominal_stress = std::abs(r.axial) / w + 6.0 * std::abs(r.moment) / (w * w);
+  return r;
+}
+
 }  // namespace dem2d

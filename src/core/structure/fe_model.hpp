@@ -9,8 +9,10 @@
 // Per bar: the tip displacement is that of the top face's middle node (lateral offset 0), in
 // the drum frame and resolved along the bar's side direction perp(radial) (counter-clockwise)
 // and its radial direction; the peak von Mises stress of the bar is the largest over its
-// elements' Gauss points (the nodal values at the feet, where the bar's sides meet the shell at
-// a right angle, grow without bound as the mesh is refined: a re-entrant corner).
+// elements' Gauss points. That peak depends on the mesh: the elastic stress is singular under a
+// point force and at the feet, where the bar's sides meet the shell at a right angle (a
+// re-entrant corner), and the peak grows there as the mesh is refined. bar_root gives a
+// mesh-independent measure, the nominal stress at the bar's root.
 #pragma once
 
 #include <Eigen/Dense>
@@ -40,6 +42,18 @@ struct BarResponse {
   double peak_von_mises = 0.0;  // Pa, over the bar's Gauss points
 };
 
+// The load a bar hands the shell at its feet, from statics: the resultant of the nodal loads on
+// the bar's own nodes (not the feet), and its moment about the centre of the feet's chord
+// (the bar's axis at FeBar::foot). The nominal root stress is the largest axial stress of a
+// beam section of width w under them, |N| / w + 6 |M| / w^2: unlike the peak von Mises it does
+// not depend on the mesh.
+struct BarRoot {
+  double axial = 0.0;   // N/m, along -radial (towards the centre): pulling the bar off the shell
+  double shear = 0.0;   // N/m, along perp(radial)
+  double moment = 0.0;  // N m/m, counter-clockwise
+  double nominal_stress = 0.0;  // Pa
+};
+
 class FeModel {
  public:
   FeModel(FeMesh mesh, const ElasticMaterial& material);
@@ -65,6 +79,7 @@ class FeModel {
 
   FeStress stress(const FeVector& u) const;
   BarResponse bar_response(std::size_t bar, const FeVector& u, const FeStress& s) const;
+  BarRoot bar_root(std::size_t bar, const FeVector& f) const;
 
  private:
   Q9Nodes element_nodes(std::size_t e) const;
