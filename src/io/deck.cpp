@@ -874,6 +874,8 @@ class DeckParser {
     } else if (d.sides != 0) {
       r.error(fmt::format("a [shell] needs a round drum (drum.sides = 0); the drum is a {}-gon",
                           d.sides));
+    } else if (d.lifters.empty()) {
+      r.error("a [shell] reports per lifter bar (lifters.csv): the drum needs [[drum.lifter]]");
     } else if (r.has("thickness") && s.thickness >= 0.5 * d.radius) {
       r.invalid("thickness", fmt::format("must be below half the drum radius {:g} m", d.radius));
     } else if (s.element_size && (*s.element_size > 0.25 * d.radius ||

@@ -1151,9 +1151,9 @@ inline constexpr Key<SieveSpec> kSieveKeys[] = {
 
 inline constexpr Key<ShellSpec> kShellKeys[] = {
     {.name = "thickness",
+     .need = Need::kRequired,
      .unit = "m",
      .range = kPositive,
-     .need = Need::kRequired,
      .field = member<&ShellSpec::thickness>(),
      .allowed = "> 0, below half the drum radius",
      .doc = "the shell ring's wall, outside the drum's circle (its outer surface is held fixed)"},
@@ -1174,18 +1174,18 @@ inline constexpr Key<ShellSpec> kShellKeys[] = {
      .unit = "m",
      .range = kPositive,
      .field = member<&ShellSpec::element_size>(),
-     .allowed = "> 0, from 2π R / 20 000 to R / 4 (R the drum radius)",
      .default_text = "the thickness",
+     .allowed = "> 0, from 2π R / 20 000 to R / 4 (R the drum radius)",
      .doc = "the elements' length along the ring (the bars' feet fall on nodes: the spacing is "
             "adjusted to them)"},
     {.name = "depth",
+     .need = Need::kRequired,
      .unit = "m",
      .range = kPositive,
      .field = member<&ShellSpec::depth>(),
-     .default_text = "the slice thickness",
      .doc = "the depth of mill the slice stands for: a contact force F loads the plane-strain "
-            "model with F / depth per metre; by default the charge's mass-weighted mean "
-            "diameter (`run.json` `mill.slice_thickness_m`)"},
+            "model with F / depth per metre of shell; `dem2d --check` prints the charge's "
+            "slice thickness (its mass-weighted mean diameter), the natural choice"},
 };
 
 inline constexpr Key<OutputSpec> kOutputKeys[] = {

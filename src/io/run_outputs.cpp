@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -110,29 +111,83 @@ struct LifterCodec {
   }
 };
 
+// A wall load record on the shell or a bar, with its particle's id: the shell's input.
+struct ShellContact {
+  std::int64_t id = 0;
+  std::int32_t element = 0;
+  Vec2 point{}, force{};
+};
+bool key_before(const ShellContact& a, const ShellContact& b) {
+  return a.id < b.id || (a.id == b.id && a.element < b.element);
+}
+struct ShellCodec {
+  static constexpr std::size_t kWords = 6;
+  static void put(const ShellContact& c, std::vector<std::int64_t>& w) {
+    w.insert(w.end(), {c.id, c.element, std::bit_cast<std::int64_t>(c.point.x),
+                       std::bit_cast<std::int64_t>(c.point.y), std::bit_cast<std::int64_t>(c.force.x),
+                       std::bit_cast<std::int64_t>(c.force.y)});
+  }
+  static ShellContact from(const std::int64_t* w) {
+    return {w[0], static_cast<std::int32_t>(w[1]),
+            Vec2{std::bit_cast<double>(w[2]), std::bit_cast<double>(w[3])},
+            Vec2{std::bit_cast<double>(w[4]), std::bit_cast<double>(w[5])}};
+  }
+};
+
+// This rank's records on the shell and the bars, in the records' order (by particle id, then
+// element, as one rank's wall list runs).
+std::vector<ShellContact> shell_contacts(const Simulation& sim) {
+  std::vector<ShellContact> out;
+  const auto& elements = sim.walls().elements();
+  for (const WallLoad& l : sim.contacts().wall_loads()) {
+    if (elements[static_cast<std::size_t>(l.element)].part == WallPart::kWall) continue;
+    out.push_back({sim.particles().id[static_cast<std::size_t>(l.particle)], l.element, l.point,
+                   l.force});
+  }
+  return out;
+}
+
 }  // namespace
 
 LifterOutput::LifterOutput(const Scene& scene, const Simulation& sim, bool resumed) {
   auto bars = std::make_unique<LifterBars>(scene, sim.walls());
   if (bars->empty()) return;
   bars_ = std::move(bars);
+  has_shell_ = scene.shell.present;
   std::string error;
   try {
-    log_ = std::make_unique<LifterLog>(scene.output.directory + "/" + kLiftersFile,
-                                       mpi::rank(MPI_COMM_WORLD) == 0, resumed ? sim.time() : -1.0);
+    const bool active = mpi::rank(MPI_COMM_WORLD) == 0;
+    log_ = std::make_unique<LifterLog>(scene.output.directory + "/" + kLiftersFile, active,
+                                       has_shell_, resumed ? sim.time() : -1.0);
+    if (has_shell_ && active) shell_ = std::make_unique<Shell>(scene, sim.walls());
   } catch (const IoError& e) {
     error = e.what();
+  } catch (const std::invalid_argument& e) {
+    error = std::string("cannot build the shell's finite elements: ") + e.what();
   }
   mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
 }
+
+LifterOutput::~LifterOutput() = default;
 
 void LifterOutput::write(const Simulation& sim) {
   if (!bars_) return;
   const std::vector<LifterContact> all = gather_in_key_order<LifterCodec>(
       bars_->contacts(sim.contacts().wall_loads(), sim.particles(), sim.walls()));
+  std::vector<ShellContact> on_shell;
+  if (has_shell_) on_shell = gather_in_key_order<ShellCodec>(shell_contacts(sim));
   std::string error;
   try {
-    if (mpi::rank(MPI_COMM_WORLD) == 0) log_->write(sim.time(), bars_->sum(all, sim.walls()));
+    if (mpi::rank(MPI_COMM_WORLD) == 0) {
+      if (shell_) {
+        std::vector<WallLoad> records;
+        records.reserve(on_shell.size());
+        for (const ShellContact& c : on_shell)
+          records.push_back({c.element, 0, c.point, c.force, 0.0, Vec2{}});
+        response_ = shell_->respond(records, sim.walls());
+      }
+      log_->write(sim.time(), bars_->sum(all, sim.walls()), response_.bars);
+    }
   } catch (const IoError& e) {
     error = e.what();
   }

@@ -251,7 +251,7 @@ struct ShellSpec {
   std::string material;                    // empty: the drum's
   int elements_through_thickness = 2;      // across the ring and across each bar
   std::optional<double> element_size;      // m, along the ring; unset: the thickness
-  std::optional<double> depth;             // m, the slice's depth; unset: the slice thickness
+  double depth = 0.0;                      // m, the depth of mill the slice stands for
 };
 
 struct OutputSpec {
