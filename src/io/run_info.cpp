@@ -124,7 +124,6 @@ JsonObject shell_json(const LifterOutput& lifters) {
       .add_integer("last_records", static_cast<std::int64_t>(r.records))
       .add_number("last_load_N_per_m", norm(r.applied))
       .add_number("last_nodal_load_error_N_per_m", norm(r.nodal - r.applied))
-      .add_number("last_reaction_error_N_per_m", norm(r.reaction + r.nodal))
       .add_number("last_max_displacement_m", r.max_displacement);
   return o;
 }

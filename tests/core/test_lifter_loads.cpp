@@ -209,7 +209,7 @@ TEST(ShellResponse, ABallAtRestOnALiftingFaceLoadsTheSupportsWithItsWeightAndBen
     const double weight = p.mass[0] * 9.81;
     ASSERT_LT(norm(p.vel[0]), 1e-5) << "the ball has settled on the face";
     const Shell shell(sim.scene(), sim.walls());
-    const ShellResponse r = shell.respond(sim.contacts().wall_loads(), sim.walls());
+    const ShellResponse r = shell.respond(sim.contacts().wall_loads(), sim.walls(), true);
     ASSERT_EQ(r.records, 1u);
     ASSERT_EQ(r.bars.size(), 1u);
     // The weight in the drum frame (turned by the drum's angle 0.7), per metre of depth.
@@ -246,7 +246,7 @@ TEST(ShellResponse, TheNodalLoadsAddUpToTheWallLoadsAtEveryStep) {
   for (int step = 0; step < 50; ++step) {
     sim.step();
     const std::span<const WallLoad> loads = sim.contacts().wall_loads();
-    const ShellResponse r = shell.respond(loads, sim.walls());
+    const ShellResponse r = shell.respond(loads, sim.walls(), true);
     // The records' forces on the walls, summed here in the lab frame and turned to the drum's.
     Vec2 lab{};
     for (const WallLoad& w : loads) lab -= w.force;

@@ -110,12 +110,7 @@ FeStress FeModel::stress(const FeVector& u) const {
   s.nodal.assign(mesh_.nodes.size(), PlaneStress{});
   std::vector<int> count(mesh_.nodes.size(), 0);
   for (std::size_t e = 0; e < mesh_.elements.size(); ++e) {
-    Eigen::Matrix<double, 18, 1> ue;
-    for (int a = 0; a < 9; ++a) {
-      ue(2 * a) = u(2 * mesh_.elements[e][a]);
-      ue(2 * a + 1) = u(2 * mesh_.elements[e][a] + 1);
-    }
-    s.gauss[e] = q9_gauss_stress(element_nodes(e), ue, material_);
+    s.gauss[e] = gauss_stress(e, u);
     const std::array<PlaneStress, 9> at_nodes = q9_nodal_stress(s.gauss[e]);
     for (int a = 0; a < 9; ++a) {
       PlaneStress& n = s.nodal[static_cast<std::size_t>(mesh_.elements[e][a])];
@@ -131,6 +126,23 @@ FeStress FeModel::stress(const FeVector& u) const {
     s.nodal[i] = {w * s.nodal[i].xx, w * s.nodal[i].yy, w * s.nodal[i].xy, w * s.nodal[i].zz};
   }
   return s;
+}
+
+std::array<PlaneStress, 9> FeModel::gauss_stress(std::size_t e, const FeVector& u) const {
+  Eigen::Matrix<double, 18, 1> ue;
+  for (int a = 0; a < 9; ++a) {
+    ue(2 * a) = u(2 * mesh_.elements[e][a]);
+    ue(2 * a + 1) = u(2 * mesh_.elements[e][a] + 1);
+  }
+  return q9_gauss_stress(element_nodes(e), ue, material_);
+}
+
+BarResponse FeModel::bar_response(std::size_t bar, const FeVector& u) const {
+  FeStress s;
+  s.gauss.resize(mesh_.elements.size());
+  for (const int e : mesh_.bars.at(bar).elements)
+    s.gauss[static_cast<std::size_t>(e)] = gauss_stress(static_cast<std::size_t>(e), u);
+  return bar_response(bar, u, s);
 }
 
 BarResponse FeModel::bar_response(std::size_t bar, const FeVector& u, const FeStress& s) const {

@@ -79,6 +79,11 @@ class FeModel {
 
   FeStress stress(const FeVector& u) const;
   BarResponse bar_response(std::size_t bar, const FeVector& u, const FeStress& s) const;
+  // The same from the bar's own elements' stresses alone (the same values, without the rest of
+  // the mesh's).
+  BarResponse bar_response(std::size_t bar, const FeVector& u) const;
+  // Element e's stresses at its Gauss points.
+  std::array<PlaneStress, 9> gauss_stress(std::size_t e, const FeVector& u) const;
   BarRoot bar_root(std::size_t bar, const FeVector& f) const;
 
  private:

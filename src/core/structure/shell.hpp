@@ -39,7 +39,7 @@ struct ShellResponse {
   std::size_t records = 0;     // the wall load records placed on the mesh
   Vec2 applied{};              // the sum of the records' loads on the walls / depth, drum frame
   Vec2 nodal{};                // the sum of the nodal loads, N/m
-  Vec2 reaction{};             // the sum of the supports' reactions, N/m (= -nodal)
+  Vec2 reaction{};             // with `check`: the sum of the supports' reactions, N/m (= -nodal)
   double max_displacement = 0.0;  // the largest nodal displacement, m
 };
 
@@ -49,8 +49,10 @@ class Shell {
   Shell(const Scene& scene, const Walls& walls);
 
   // The response to `records` (a moment's wall loads of every rank, in key order) at the walls'
-  // current pose.
-  ShellResponse respond(std::span<const WallLoad> records, const Walls& walls) const;
+  // current pose; `check`: also the supports' reactions (a product with the whole stiffness,
+  // as long as the solve itself).
+  ShellResponse respond(std::span<const WallLoad> records, const Walls& walls,
+                        bool check = false) const;
 
   const FeModel& model() const { return model_; }
   double depth() const { return depth_; }
