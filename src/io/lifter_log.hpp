@@ -17,7 +17,8 @@ namespace dem2d {
 
 inline constexpr const char* kLiftersHeader =
     "time,lifter,angle_deg,normal_N,radial_N,torque_Nm,contacts";
-inline constexpr const char* kLiftersShellColumns = ",tip_deflection_m,von_mises_max_Pa,root_stress_Pa";
+inline constexpr const char* kLiftersShellColumns =
+    ",tip_deflection_m,von_mises_max_Pa,root_stress_Pa";
 
 class LifterLog {
  public:

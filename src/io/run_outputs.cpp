@@ -102,12 +102,17 @@ std::vector<R> gather_in_key_order(const std::vector<R>& mine) {
 struct LifterCodec {
   static constexpr std::size_t kWords = 6;
   static void put(const LifterContact& c, std::vector<std::int64_t>& w) {
-    w.insert(w.end(), {c.id, c.element, c.bar, std::bit_cast<std::int64_t>(c.normal),
-                       std::bit_cast<std::int64_t>(c.radial), std::bit_cast<std::int64_t>(c.torque)});
+    w.insert(w.end(),
+             {c.id, c.element, c.bar, std::bit_cast<std::int64_t>(c.normal),
+              std::bit_cast<std::int64_t>(c.radial), std::bit_cast<std::int64_t>(c.torque)});
   }
   static LifterContact from(const std::int64_t* w) {
-    return {w[0], static_cast<std::int32_t>(w[1]), static_cast<std::int32_t>(w[2]),
-            std::bit_cast<double>(w[3]), std::bit_cast<double>(w[4]), std::bit_cast<double>(w[5])};
+    return {w[0],
+            static_cast<std::int32_t>(w[1]),
+            static_cast<std::int32_t>(w[2]),
+            std::bit_cast<double>(w[3]),
+            std::bit_cast<double>(w[4]),
+            std::bit_cast<double>(w[5])};
   }
 };
 
@@ -123,9 +128,10 @@ bool key_before(const ShellContact& a, const ShellContact& b) {
 struct ShellCodec {
   static constexpr std::size_t kWords = 6;
   static void put(const ShellContact& c, std::vector<std::int64_t>& w) {
-    w.insert(w.end(), {c.id, c.element, std::bit_cast<std::int64_t>(c.point.x),
-                       std::bit_cast<std::int64_t>(c.point.y), std::bit_cast<std::int64_t>(c.force.x),
-                       std::bit_cast<std::int64_t>(c.force.y)});
+    w.insert(w.end(),
+             {c.id, c.element, std::bit_cast<std::int64_t>(c.point.x),
+              std::bit_cast<std::int64_t>(c.point.y), std::bit_cast<std::int64_t>(c.force.x),
+              std::bit_cast<std::int64_t>(c.force.y)});
   }
   static ShellContact from(const std::int64_t* w) {
     return {w[0], static_cast<std::int32_t>(w[1]),
@@ -141,8 +147,8 @@ std::vector<ShellContact> shell_contacts(const Simulation& sim) {
   const auto& elements = sim.walls().elements();
   for (const WallLoad& l : sim.contacts().wall_loads()) {
     if (elements[static_cast<std::size_t>(l.element)].part == WallPart::kWall) continue;
-    out.push_back({sim.particles().id[static_cast<std::size_t>(l.particle)], l.element, l.point,
-                   l.force});
+    out.push_back(
+        {sim.particles().id[static_cast<std::size_t>(l.particle)], l.element, l.point, l.force});
   }
   return out;
 }

@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "core/geometry/lifter_loads.hpp"
-#include "core/structure/shell.hpp"
 #include "core/run/simulation.hpp"
+#include "core/structure/shell.hpp"
 #include "io/lifter_log.hpp"
 #include "io/ore_logs.hpp"
 #include "io/series.hpp"

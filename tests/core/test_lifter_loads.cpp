@@ -216,8 +216,7 @@ TEST(ShellResponse, ABallAtRestOnALiftingFaceLoadsTheSupportsWithItsWeightAndBen
     const Vec2 w = rotate(Vec2{0.0, -weight / 0.1}, -0.7);
     std::cout << "[ shell ] bar at " << bar_deg << " deg: load " << r.applied.x << ", "
               << r.applied.y << " N/m (weight " << w.x << ", " << w.y << "), tip "
-              << r.bars[0].tip_deflection << " m, root stress " << r.bars[0].root_stress
-              << " Pa\n";
+              << r.bars[0].tip_deflection << " m, root stress " << r.bars[0].root_stress << " Pa\n";
     EXPECT_LT(norm(r.applied - w), 1e-4 * norm(w));
     EXPECT_LT(norm(r.nodal - r.applied), 1e-13 * norm(w)) << "the nodal loads are the load";
     EXPECT_LT(norm(r.reaction + r.nodal), 1e-9 * norm(w)) << "the supports carry it all";

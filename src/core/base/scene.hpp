@@ -247,11 +247,11 @@ struct SieveSpec {
 // docs/models.md "The shell as finite elements"), loaded by the charge's wall contacts.
 struct ShellSpec {
   bool present = false;
-  double thickness = 0.0;                  // m, the ring outside the drum's circle
-  std::string material;                    // empty: the drum's
-  int elements_through_thickness = 2;      // across the ring and across each bar
-  std::optional<double> element_size;      // m, along the ring; unset: the thickness
-  double depth = 0.0;                      // m, the depth of mill the slice stands for
+  double thickness = 0.0;              // m, the ring outside the drum's circle
+  std::string material;                // empty: the drum's
+  int elements_through_thickness = 2;  // across the ring and across each bar
+  std::optional<double> element_size;  // m, along the ring; unset: the thickness
+  double depth = 0.0;                  // m, the depth of mill the slice stands for
 };
 
 struct OutputSpec {
