@@ -262,5 +262,24 @@ TEST(ShellResponse, TheNodalLoadsAddUpToTheWallLoadsAtEveryStep) {
   EXPECT_LT(worst, 1e-13);
 }
 
+TEST(ShellResponse, TheShellsOwnMaterialSetsNoContactTime) {
+  // The shell's finite elements take a stiff liner steel no particle and no wall has: the run's
+  // automatic dt stays the charge's (a wall of that material would shorten it 1.3-fold).
+  Scene plain = ball_on_a_bar(80.0, 0.0);
+  Scene shelled = plain;
+  add_shell(shelled);
+  MaterialSpec liner = plain.materials[0];
+  liner.name = "liner";
+  liner.youngs_modulus = 2.1e11;
+  liner.shear_modulus = 8.1e10;
+  shelled.materials.push_back(liner);
+  shelled.shell.material = "liner";
+  const Simulation a(plain), b(shelled);
+  EXPECT_EQ(a.dt(), b.dt());
+  Scene liner_walls = shelled;
+  liner_walls.drum.material = "liner";
+  EXPECT_LT(Simulation(liner_walls).dt(), 0.9 * a.dt()) << "a wall of it does set one";
+}
+
 }  // namespace
 }  // namespace dem2d

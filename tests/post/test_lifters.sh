@@ -9,7 +9,8 @@
 #   - a deck without lifters writes no lifters.csv;
 #   - with a [shell] (inputs/shell.in): lifters.csv carries the shell's columns, the same bytes
 #     on 1, 2 and 3 ranks and across a restart; a bar with no contact is barely deflected
-#     against the loaded ones; run.json's shell figures (nodal loads = wall loads);
+#     against the loaded ones; run.json's shell figures (nodal loads = wall loads); the deck
+#     without its [shell] runs the same bits (series.csv, the loads of lifters.csv);
 #   - post/plot_lifters.py draws a PNG, prints the CSV's own largest normal load as its peak
 #     (and writes it bit for bit with --json), a loaded window around the mean profile's peak,
 #     and --window keeps the rows of the last T seconds.
@@ -166,6 +167,17 @@ check "shell: resumed on 1 rank" "$dem2d" "$sh" "${srun[@]}" --output "$work/srs
 for other in s2 s3 srs; do
   check "shell: lifters.csv s1 = $other, byte for byte" cmp "$work/s1/lifters.csv" "$work/$other/lifters.csv"
 done
+# One-way: the charge sees the rigid drum, so the deck without its [shell] (the shell's material
+# still defined) runs the same bits.
+sed '/^\[shell\]/,/^element_size/d' "$sh" > "$work/bare_shell.in"
+check "shell: the deck without its [shell]" "$dem2d" "$work/bare_shell.in" "${srun[@]}" --output "$work/s0"
+check "shell: series.csv the same bytes without the [shell]" cmp "$work/s1/series.csv" "$work/s0/series.csv"
+check "shell: lifters.csv's loads the same without the [shell]" "$py" - "$work/s1" "$work/s0" <<'PY'
+import csv, sys
+a, b = (list(csv.reader(open(f"{d}/lifters.csv"))) for d in sys.argv[1:3])
+assert len(a) == len(b) and len(b[0]) == 7, (len(a), len(b), b[0])
+assert all(x[:7] == y for x, y in zip(a, b)), "the loads differ"
+PY
 check "shell: lifters.csv's shell columns and run.json" "$py" - "$work/s1" <<'PY'
 import csv, json, sys
 d = sys.argv[1]
