@@ -14,7 +14,9 @@ reference of the ratios. Over the last `window` seconds of each run (the second 
     percentile and their histogram (the velocity distribution);
   - lifters.csv, when the run wrote one: the normal load on the lifter bars against their angle,
     folded onto one angle axis, its peak bin mean and the loaded window around it (the bins
-    above 10 % of it), as post/plot_lifters.py reads them.
+    above 10 % of it), as post/plot_lifters.py reads them; with a [shell] (inputs/shell.in) also
+    the bars' largest tip deflection, the peak of their mean tip deflection per angle bin and
+    its angle, and the largest root stress.
 It prints a table with each figure's ratio to the reference (angles: the difference in
 degrees), writes the figures as JSON (--json), and draws the last snapshot of each run side by
 side with the speed histograms and the lifter loads (-o). Exit 1 when a folder lacks what it
@@ -95,6 +97,11 @@ def measure(folder, window):
         out["lifter_peak_angle_deg"] = fig["mean_peak_angle_deg"]
         out["lifter_loaded_window_deg"] = [fig["loaded_from_deg"], fig["loaded_to_deg"]]
         out["_lifter_profile"] = (centres, mean)
+        if "peak_tip_deflection_m" in fig:  # the run had a [shell]
+            out["tip_peak_m"] = fig["peak_tip_deflection_m"]
+            out["tip_mean_peak_m"] = fig["mean_peak_tip_deflection_m"]
+            out["tip_mean_peak_angle_deg"] = fig["mean_peak_tip_angle_deg"]
+            out["root_stress_peak_Pa"] = fig["peak_root_stress_Pa"]
     out["_speeds"] = v
     out["_last"] = last
     out["_deck"] = millplot.deck_of(run)
@@ -105,7 +112,11 @@ FIGURES = [("shoulder_angle_deg", "shoulder angle [deg]"), ("toe_angle_deg", "to
            ("power_W", "drive power [W]"), ("speed_mean", "mean speed [m/s]"),
            ("speed_median", "median speed [m/s]"), ("speed_p90", "90th pct speed [m/s]"),
            ("lifter_peak_normal_N", "lifter mean normal load, peak [N]"),
-           ("lifter_peak_angle_deg", "... at the angle [deg]")]
+           ("lifter_peak_angle_deg", "... at the angle [deg]"),
+           ("tip_peak_m", "lifter tip deflection, max [m]"),
+           ("tip_mean_peak_m", "lifter tip, mean's peak [m]"),
+           ("tip_mean_peak_angle_deg", "... at the angle [deg]"),
+           ("root_stress_peak_Pa", "lifter root stress, max [Pa]")]
 
 
 def table(runs):

@@ -7,12 +7,16 @@
 lifters.csv has one row per bar per series row (docs/output.md): time, lifter, angle_deg (the
 bar's position from the bottom of the drum, in its sense of rotation), normal_N (the charge's
 load on the bar's lifting face), radial_N (its load along the bar, outward positive),
-torque_Nm and contacts. Forces are those of the 2D model: per slice, N.
+torque_Nm and contacts. Forces are those of the 2D model: per slice, N. With a [shell] in the
+deck it also has the shell's response per bar: tip_deflection_m (the bar's tip pushed back,
+against the drum's rotation), von_mises_max_Pa (the bar's peak von Mises stress, which depends
+on the mesh) and root_stress_Pa (the nominal stress of its root section).
 
 All bars are folded onto one angle axis: every row of every bar falls into its angle's bin
 (--bins over 0-360 degrees, default 72: 5 degrees). Two panels, normal and radial load against
-the angle: the rows faint, the mean per bin and the largest per bin. --window T keeps the rows
-of the last T seconds (default: all).
+the angle: the rows faint, the mean per bin and the largest per bin; with the shell's columns
+two more, the tip deflection and the stresses. --window T keeps the rows of the last T seconds
+(default: all).
 
 Printed, and with --json written to F (one object):
   - the peak: the largest normal_N of the rows kept (`peak_normal_N`), at which angle, time and
@@ -21,7 +25,11 @@ Printed, and with --json written to F (one object):
   - the loaded angle window: the bins around the mean profile's peak whose mean normal load
     exceeds 10 % of that peak, as `loaded_from_deg` to `loaded_to_deg` (bin edges, in the sense
     of rotation; `loaded_to_deg` may exceed 360 when the window passes the bottom), or null
-    when no bar carries any load.
+    when no bar carries any load;
+  - with the shell's columns: the largest tip deflection (`peak_tip_deflection_m`, at
+    `peak_tip_angle_deg`, bar `peak_tip_lifter`), the mean profile's peak
+    (`mean_peak_tip_deflection_m` at `mean_peak_tip_angle_deg`), and the largest von Mises and
+    root stresses (`peak_von_mises_Pa`, `peak_root_stress_Pa`).
 The figure is a PNG (default: lifters.png beside the CSV), titled with run.json's deck title
 (--title overrides).
 """
@@ -44,6 +52,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import millplot  # noqa: E402
 
 COLUMNS = ["time", "lifter", "angle_deg", "normal_N", "radial_N", "torque_Nm", "contacts"]
+SHELL_COLUMNS = ["tip_deflection_m", "von_mises_max_Pa", "root_stress_Pa"]
 LOADED_FRACTION = 0.1
 
 
@@ -52,11 +61,16 @@ def read_lifters(path):
     with open(path, newline="") as f:
         reader = csv.reader(f)
         header = next(reader, None)
-        if header != COLUMNS:
-            raise SystemExit(f"{path}: not a lifters.csv (columns {header}, expected {COLUMNS})")
+        if header not in (COLUMNS, COLUMNS + SHELL_COLUMNS):
+            raise SystemExit(f"{path}: not a lifters.csv (columns {header}, expected {COLUMNS}, "
+                             f"with the shell's {SHELL_COLUMNS} after them)")
         rows = [r for r in reader if r]
-    data = {c: np.array([float(r[k]) for r in rows]) for k, c in enumerate(COLUMNS)}
+    data = {c: np.array([float(r[k]) for r in rows]) for k, c in enumerate(header)}
     return data
+
+
+def has_shell(data):
+    return SHELL_COLUMNS[0] in data
 
 
 def select_window(data, window):
@@ -128,19 +142,37 @@ def figures(data, bins):
     out["loaded_threshold_N"] = LOADED_FRACTION * float(filled[top]) if window else None
     out["loaded_from_deg"] = window[0] * width if window else None
     out["loaded_to_deg"] = (window[0] + window[1]) * width if window else None
+    if has_shell(data):
+        tip = data["tip_deflection_m"]
+        k = int(np.argmax(tip))
+        out["peak_tip_deflection_m"] = float(tip[k])
+        out["peak_tip_angle_deg"] = float(data["angle_deg"][k])
+        out["peak_tip_time_s"] = float(data["time"][k])
+        out["peak_tip_lifter"] = int(data["lifter"][k])
+        mean_tip, _ = binned(data["angle_deg"], tip, bins)
+        filled = np.where(np.isnan(mean_tip), -np.inf, mean_tip)
+        top = int(np.argmax(filled))
+        out["mean_peak_tip_deflection_m"] = float(filled[top])
+        out["mean_peak_tip_angle_deg"] = (top + 0.5) * width
+        out["peak_von_mises_Pa"] = float(data["von_mises_max_Pa"].max())
+        out["peak_root_stress_Pa"] = float(data["root_stress_Pa"].max())
     return out
 
 
 def plot(data, bins, fig_out, path_png, title):
     width = 360.0 / bins
     centres = (np.arange(bins) + 0.5) * width
-    fig, axes = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
-    for ax, column, label in (
-        (axes[0], "normal_N", "normal load on the lifting face (N per slice)"),
-        (axes[1], "radial_N", "radial load, outward (N per slice)"),
-    ):
-        mean, peak = binned(data["angle_deg"], data[column], bins)
-        ax.plot(data["angle_deg"], data[column], ".", color="0.75", ms=2, label="rows")
+    panels = [("normal_N", "normal load on the lifting face (N per slice)", 1.0),
+              ("radial_N", "radial load, outward (N per slice)", 1.0)]
+    if has_shell(data):
+        panels += [("tip_deflection_m", "tip deflection, pushed back (µm)", 1e6),
+                   ("root_stress_Pa", "root section's nominal stress (MPa)", 1e-6),
+                   ("von_mises_max_Pa", "peak von Mises stress in the bar (MPa)", 1e-6)]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(9, 3.5 * len(panels)), sharex=True)
+    for ax, (column, label, scale) in zip(axes, panels):
+        values = scale * data[column]
+        mean, peak = binned(data["angle_deg"], values, bins)
+        ax.plot(data["angle_deg"], values, ".", color="0.75", ms=2, label="rows")
         ax.plot(centres, mean, "-", color="C0", lw=2, label="mean per bin")
         ax.plot(centres, peak, "-", color="C3", lw=1, label="max per bin")
         ax.axhline(0.0, color="k", lw=0.5)
@@ -151,9 +183,9 @@ def plot(data, bins, fig_out, path_png, title):
         ax.set_ylabel(label)
         ax.legend(loc="upper right", fontsize=8)
         ax.grid(alpha=0.3)
-    axes[1].set_xlim(0.0, 360.0)
-    axes[1].set_xticks(np.arange(0, 361, 45))
-    axes[1].set_xlabel("bar angle from the bottom of the drum, in its sense of rotation (deg)")
+    axes[-1].set_xlim(0.0, 360.0)
+    axes[-1].set_xticks(np.arange(0, 361, 45))
+    axes[-1].set_xlabel("bar angle from the bottom of the drum, in its sense of rotation (deg)")
     if fig_out.get("loaded_from_deg") is not None:
         axes[0].set_title("shaded: the loaded window (mean normal load above 10 % of its peak)",
                           fontsize=9)
@@ -201,6 +233,14 @@ def main(argv=None):
         else:
             print(f"loaded window: {out['loaded_from_deg']:.6g} to {out['loaded_to_deg']:.6g} deg "
                   f"(mean normal load above {out['loaded_threshold_N']:.6g} N, 10 % of its peak)")
+        if has_shell(data):
+            print(f"peak tip deflection: {out['peak_tip_deflection_m']:.6g} m at "
+                  f"{out['peak_tip_angle_deg']:.6g} deg (bar {out['peak_tip_lifter']}, t = "
+                  f"{out['peak_tip_time_s']:.6g} s); mean profile's peak "
+                  f"{out['mean_peak_tip_deflection_m']:.6g} m at "
+                  f"{out['mean_peak_tip_angle_deg']:.6g} deg")
+            print(f"peak stresses: von Mises {out['peak_von_mises_Pa']:.6g} Pa, root "
+                  f"{out['peak_root_stress_Pa']:.6g} Pa")
         print(f"figure: {png}")
     if args.json:
         with open(args.json, "w") as f:

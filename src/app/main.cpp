@@ -189,7 +189,7 @@ int run(const Options& opt) {
   const RunInfo info = run_info(
       sim, domain, scene,
       {n_global, loop.particles(), loop.particle_steps(), wall, sim.step_count() - first_step,
-       ending == Ending::kInterrupted, opt.restart, opt.sets, loop.warnings()});
+       ending == Ending::kInterrupted, opt.restart, opt.sets, loop.warnings(), &loop.lifters()});
   if (g_rank == 0) write_run_json(out.directory + "/" + kRunJsonFile, scene, info);
   if (is_ore_scene(scene)) {
     const GrindingReport sizes = grinding_report(sim, domain);

@@ -139,6 +139,7 @@ class DeckParser {
     if (const auto* t = root.table("breakage")) read_breakage(*t);
     if (const auto* t = root.table("feed")) read_feed(*t);
     if (const auto* t = root.table("sieve")) read_sieve(*t);
+    if (const auto* t = root.table("shell")) read_shell(*t);
     if (const auto* t = root.table("output")) read_output(*t);
     check_ore(root_);
     check_shapes(root_);
@@ -858,6 +859,32 @@ class DeckParser {
     }
     if (s.type == DischargeType::kOverflow && !r.has("holdup"))
       r.missing("holdup", "type = \"overflow\", the ore hold-up in kg");
+  }
+
+  // The shell needs a round drum (the ring is meshed about its circle) whose radius its wall and
+  // elements fit.
+  void read_shell(const toml::table& table) {
+    const TableReader r(diag_, table, deck::kShell);
+    ShellSpec& s = scene_.shell;
+    s.present = true;
+    read_keys(r, deck::kShell, s);
+    const DrumSpec& d = scene_.drum;
+    if (!d.present) {
+      r.error("a [shell] needs a [drum]: it is the drum's wall");
+    } else if (d.sides != 0) {
+      r.error(fmt::format("a [shell] needs a round drum (drum.sides = 0); the drum is a {}-gon",
+                          d.sides));
+    } else if (d.lifters.empty()) {
+      r.error("a [shell] reports per lifter bar (lifters.csv): the drum needs [[drum.lifter]]");
+    } else if (r.has("thickness") && s.thickness >= 0.5 * d.radius) {
+      r.invalid("thickness", fmt::format("must be below half the drum radius {:g} m", d.radius));
+    } else if (s.element_size && (*s.element_size > 0.25 * d.radius ||
+                                  2.0 * std::numbers::pi * d.radius / *s.element_size > 20000.0)) {
+      r.invalid("element_size",
+                fmt::format("must lie between {:g} m (20 000 elements around the ring) and a "
+                            "quarter of the drum radius, {:g} m",
+                            2.0 * std::numbers::pi * d.radius / 20000.0, 0.25 * d.radius));
+    }
   }
 
   // The rules between the ore tables, each message naming the keys on both sides:

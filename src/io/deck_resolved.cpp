@@ -106,6 +106,7 @@ DeckTable scene_table(const Scene& scene) {
     root.table("breakage", keys_table(deck::kBreakage, scene.breakage, model));
   if (scene.feed.present) root.table("feed", keys_table(deck::kFeed, scene.feed, model));
   if (scene.sieve.present) root.table("sieve", keys_table(deck::kSieve, scene.sieve, model));
+  if (scene.shell.present) root.table("shell", keys_table(deck::kShell, scene.shell, model));
   root.table("output", keys_table(deck::kOutput, scene.output, model));
   return root;
 }

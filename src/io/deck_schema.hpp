@@ -1149,6 +1149,45 @@ inline constexpr Key<SieveSpec> kSieveKeys[] = {
             "screen's aperture is read)"},
 };
 
+inline constexpr Key<ShellSpec> kShellKeys[] = {
+    {.name = "thickness",
+     .need = Need::kRequired,
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&ShellSpec::thickness>(),
+     .allowed = "> 0, below half the drum radius",
+     .doc = "the shell ring's wall, outside the drum's circle (its outer surface is held fixed)"},
+    {.name = "material",
+     .type = Type::kMaterial,
+     .field = member<&ShellSpec::material>(),
+     .written_if = [](const ShellSpec& s) { return !s.material.empty(); },  // "": the drum's
+     .default_text = "the drum's",
+     .doc = "the ring's and the bars' material (its density, Young's modulus and Poisson's "
+            "ratio)"},
+    {.name = "elements_through_thickness",
+     .type = Type::kInteger,
+     .range = kAtLeastOne,
+     .max = 16,
+     .field = member<&ShellSpec::elements_through_thickness>(),
+     .doc = "quadratic elements across the ring's wall and across each lifter bar"},
+    {.name = "element_size",
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&ShellSpec::element_size>(),
+     .default_text = "the thickness",
+     .allowed = "> 0, from 2π R / 20 000 to R / 4 (R the drum radius)",
+     .doc = "the elements' length along the ring (the bars' feet fall on nodes: the spacing is "
+            "adjusted to them)"},
+    {.name = "depth",
+     .need = Need::kRequired,
+     .unit = "m",
+     .range = kPositive,
+     .field = member<&ShellSpec::depth>(),
+     .doc = "the depth of mill the slice stands for: a contact force F loads the plane-strain "
+            "model with F / depth per metre of shell; `dem2d --check` prints the charge's "
+            "slice thickness (its mass-weighted mean diameter), the natural choice"},
+};
+
 inline constexpr Key<OutputSpec> kOutputKeys[] = {
     {.name = "directory",
      .type = Type::kString,
@@ -1223,6 +1262,7 @@ inline constexpr Key<Scene> kTopLevelKeys[] = {
     {.name = "breakage", .type = Type::kTable},
     {.name = "feed", .type = Type::kTable},
     {.name = "sieve", .type = Type::kTable},
+    {.name = "shell", .type = Type::kTable},
     {.name = "output", .type = Type::kTable},
 };
 
@@ -1239,6 +1279,7 @@ inline constexpr Table<WallSpec> kWall{"wall", true, kWallKeys};
 inline constexpr Table<BreakageSpec> kBreakage{"breakage", false, kBreakageKeys};
 inline constexpr Table<FeedSpec> kFeed{"feed", false, kFeedKeys};
 inline constexpr Table<SieveSpec> kSieve{"sieve", false, kSieveKeys};
+inline constexpr Table<ShellSpec> kShell{"shell", false, kShellKeys};
 inline constexpr Table<OutputSpec> kOutput{"output", false, kOutputKeys};
 
 // Calls f(table) for every table, in the order of docs/input.md.
@@ -1257,6 +1298,7 @@ constexpr void for_each_table(F&& f) {
   f(kBreakage);
   f(kFeed);
   f(kSieve);
+  f(kShell);
   f(kOutput);
 }
 

@@ -118,6 +118,22 @@ std::string shape_solves_json(const MpiDomain& domain) {
   return o.inline_text();
 }
 
+// The shell's mesh and its response at the last lifters.csv row (rank 0's).
+JsonObject shell_json(const LifterOutput& lifters) {
+  const Shell& shell = *lifters.shell();
+  const ShellResponse& r = lifters.last_response();
+  JsonObject o;
+  o.add_integer("nodes", static_cast<std::int64_t>(shell.model().mesh().nodes.size()))
+      .add_integer("elements", static_cast<std::int64_t>(shell.model().mesh().elements.size()))
+      .add_integer("free_dofs", static_cast<std::int64_t>(shell.model().free_dofs().size()))
+      .add_number("depth_m", shell.depth())
+      .add_integer("last_records", static_cast<std::int64_t>(r.records))
+      .add_number("last_load_N_per_m", norm(r.applied))
+      .add_number("last_nodal_load_error_N_per_m", norm(r.nodal - r.applied))
+      .add_number("last_max_displacement_m", r.max_displacement);
+  return o;
+}
+
 }  // namespace
 
 RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& scene,
@@ -153,6 +169,8 @@ RunInfo run_info(const Simulation& sim, const MpiDomain& domain, const Scene& sc
   extra.add("guards_fired", guards.inline_text());
   add_decomposition(extra, domain);
   if (scene.drum.present) extra.add("mill", mill_json(sim, domain).inline_text());
+  if (facts.lifters != nullptr && facts.lifters->shell() != nullptr)
+    extra.add("shell", shell_json(*facts.lifters).inline_text());
   extra.add("interrupted", facts.interrupted ? "true" : "false");
   extra.add("restarted_from",
             facts.restarted_from.empty() ? "null" : quoted_string(facts.restarted_from));

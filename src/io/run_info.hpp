@@ -9,6 +9,7 @@
 
 #include "core/run/simulation.hpp"
 #include "io/run_json.hpp"
+#include "io/run_outputs.hpp"
 #include "parallel/mpi_domain.hpp"
 
 namespace dem2d {
@@ -21,8 +22,9 @@ struct RunFacts {
   std::int64_t steps_here = 0;  // the steps this process took (a restart continues the count)
   bool interrupted = false;     // stopped by SIGINT or SIGTERM
   std::string restarted_from;   // the checkpoint continued (--restart), empty for a new run
-  std::vector<std::string> overrides;  // the --set options, in order
-  std::vector<std::string> warnings;   // what the run warned of while it ran
+  std::vector<std::string> overrides;     // the --set options, in order
+  std::vector<std::string> warnings;      // what the run warned of while it ran
+  const LifterOutput* lifters = nullptr;  // the shell's model and last response (rank 0)
 };
 
 // Collective (the decomposition's per-rank figures and the mill's totals are gathered).

@@ -44,6 +44,8 @@ class RunLoop {
   std::int64_t particle_steps() const { return particle_steps_; }
   // The warnings the run gave while it ran (told on stderr too), for run.json.
   const std::vector<std::string>& warnings() const { return warnings_; }
+  // lifters.csv and the shell (its model and last response on rank 0).
+  const LifterOutput& lifters() const { return lifters_; }
   // Above this bed filling a fed mill is told that its charge is filling the drum (the charge
   // then reaches past the drum centre: no mill runs so full).
   static constexpr double kFillWarning = 0.5;

@@ -8,6 +8,7 @@
 
 #include "core/geometry/lifter_loads.hpp"
 #include "core/run/simulation.hpp"
+#include "core/structure/shell.hpp"
 #include "io/lifter_log.hpp"
 #include "io/ore_logs.hpp"
 #include "io/series.hpp"
@@ -40,16 +41,27 @@ class OreOutput {
 // lifters.csv of drum scenes with lifter bars (nothing for other scenes): at a series row, the
 // last force evaluation's records on the bars, resolved on their ranks, gathered (6 words per
 // record), merged in (particle id, element) order and summed per bar in that order, the same
-// bits on any rank count; rank 0 appends one row per bar.
+// bits on any rank count; rank 0 appends one row per bar. With a [shell], the records on the
+// shell and the bars are gathered in the same order (6 words each: id, element, point, force)
+// and rank 0 solves the shell's response to them (core/structure/shell.hpp) for the row's shell
+// columns.
 class LifterOutput {
  public:
   // Collective. `resumed`: a restart, which keeps the rows up to the checkpoint's time.
   LifterOutput(const Scene& scene, const Simulation& sim, bool resumed);
+  ~LifterOutput();
   void write(const Simulation& sim);  // collective
+  // The shell's model on rank 0 (null elsewhere and without a [shell]).
+  const Shell* shell() const { return shell_.get(); }
+  // The shell's response at the last row written (rank 0).
+  const ShellResponse& last_response() const { return response_; }
 
  private:
   std::unique_ptr<LifterBars> bars_;
   std::unique_ptr<LifterLog> log_;
+  bool has_shell_ = false;
+  std::unique_ptr<Shell> shell_;
+  ShellResponse response_;
 };
 
 }  // namespace dem2d

@@ -1,7 +1,10 @@
 // The load on each lifter bar (core/geometry/lifter_loads.hpp): a ball at rest on a bar's
 // lifting face hands the bar its weight, split into the face's normal and the radial; the bars'
 // torques add up to the drive's lifter torque; the sums do not depend on the order of the
-// records (the gathered records of any rank count give the same bits).
+// records (the gathered records of any rank count give the same bits). The shell's response to
+// the same records (core/structure/shell.hpp): the resting ball's weight reaches the supports
+// whole, per metre of depth, and bends the bar the way the ball pushes; in a turning charge the
+// nodal loads add up to the wall loads at every step.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +14,7 @@
 
 #include "core/geometry/lifter_loads.hpp"
 #include "core/run/simulation.hpp"
+#include "core/structure/shell.hpp"
 #include "support/scenes.hpp"
 #include "support/thesis.hpp"
 
@@ -186,6 +190,95 @@ TEST(LifterLoads, NoBarsWithoutLifters) {
   const LifterBars bars(s, walls);
   EXPECT_TRUE(bars.empty());
   EXPECT_EQ(bars.bar_of(0), -1);
+}
+
+// The shell of the scenes above: a 50 mm steel ring (E as the balls'), 0.1 m of depth.
+void add_shell(Scene& s) {
+  s.shell.present = true;
+  s.shell.thickness = 0.05;
+  s.shell.depth = 0.1;
+}
+
+TEST(ShellResponse, ABallAtRestOnALiftingFaceLoadsTheSupportsWithItsWeightAndBendsTheBarBack) {
+  for (const double bar_deg : {80.0, 100.0}) {
+    Scene scene = ball_on_a_bar(bar_deg, 0.7);
+    add_shell(scene);
+    Simulation sim(scene);
+    sim.run_until(1.5);
+    const ParticleStore& p = sim.particles();
+    const double weight = p.mass[0] * 9.81;
+    ASSERT_LT(norm(p.vel[0]), 1e-5) << "the ball has settled on the face";
+    const Shell shell(sim.scene(), sim.walls());
+    const ShellResponse r = shell.respond(sim.contacts().wall_loads(), sim.walls(), true);
+    ASSERT_EQ(r.records, 1u);
+    ASSERT_EQ(r.bars.size(), 1u);
+    // The weight in the drum frame (turned by the drum's angle 0.7), per metre of depth.
+    const Vec2 w = rotate(Vec2{0.0, -weight / 0.1}, -0.7);
+    std::cout << "[ shell ] bar at " << bar_deg << " deg: load " << r.applied.x << ", "
+              << r.applied.y << " N/m (weight " << w.x << ", " << w.y << "), tip "
+              << r.bars[0].tip_deflection << " m, root stress " << r.bars[0].root_stress << " Pa\n";
+    EXPECT_LT(norm(r.applied - w), 1e-4 * norm(w));
+    EXPECT_LT(norm(r.nodal - r.applied), 1e-13 * norm(w)) << "the nodal loads are the load";
+    EXPECT_LT(norm(r.reaction + r.nodal), 1e-9 * norm(w)) << "the supports carry it all";
+    // The ball presses the lifting face against the drum's sense of rotation (counter-
+    // clockwise here): the bar's tip moves that way, and its root is stressed.
+    EXPECT_GT(r.bars[0].tip_deflection, 0.0);
+    EXPECT_GT(r.bars[0].root_stress, 0.0);
+    EXPECT_GE(r.max_displacement, r.bars[0].tip_deflection);
+  }
+}
+
+TEST(ShellResponse, TheNodalLoadsAddUpToTheWallLoadsAtEveryStep) {
+  Scene s = thesis_drum_scene(150, 1.8, 0, 0.1);
+  LifterSpec l;
+  l.count = 12;
+  l.height = 0.2;
+  l.width = 0.1;
+  s.drum.lifters.push_back(l);
+  add_shell(s);
+  s.shell.thickness = 0.1;
+  Simulation sim(s);
+  sim.run_until(0.8);
+  const Shell shell(sim.scene(), sim.walls());
+  double worst = 0.0;
+  std::size_t most = 0;
+  for (int step = 0; step < 50; ++step) {
+    sim.step();
+    const std::span<const WallLoad> loads = sim.contacts().wall_loads();
+    const ShellResponse r = shell.respond(loads, sim.walls(), true);
+    // The records' forces on the walls, summed here in the lab frame and turned to the drum's.
+    Vec2 lab{};
+    for (const WallLoad& w : loads) lab -= w.force;
+    const Vec2 applied = rotate(lab, -sim.walls().drum_angle()) * (1.0 / 0.1);
+    ASSERT_EQ(r.records, loads.size()) << "every record is on the shell or a bar";
+    ASSERT_LT(norm(r.applied - applied), 1e-12 * norm(applied)) << "step " << step;
+    worst = std::max(worst, norm(r.nodal - r.applied) / norm(r.applied));
+    ASSERT_LT(norm(r.reaction + r.nodal), 1e-9 * norm(r.applied)) << "step " << step;
+    most = std::max(most, r.records);
+  }
+  std::cout << "[ shell ] 50 steps, up to " << most << " records: nodal loads against wall loads "
+            << worst << " (relative)\n";
+  EXPECT_GT(most, 20u);
+  EXPECT_LT(worst, 1e-13);
+}
+
+TEST(ShellResponse, TheShellsOwnMaterialSetsNoContactTime) {
+  // The shell's finite elements take a stiff liner steel no particle and no wall has: the run's
+  // automatic dt stays the charge's (a wall of that material would shorten it 1.3-fold).
+  Scene plain = ball_on_a_bar(80.0, 0.0);
+  Scene shelled = plain;
+  add_shell(shelled);
+  MaterialSpec liner = plain.materials[0];
+  liner.name = "liner";
+  liner.youngs_modulus = 2.1e11;
+  liner.shear_modulus = 8.1e10;
+  shelled.materials.push_back(liner);
+  shelled.shell.material = "liner";
+  const Simulation a(plain), b(shelled);
+  EXPECT_EQ(a.dt(), b.dt());
+  Scene liner_walls = shelled;
+  liner_walls.drum.material = "liner";
+  EXPECT_LT(Simulation(liner_walls).dt(), 0.9 * a.dt()) << "a wall of it does set one";
 }
 
 }  // namespace

@@ -1001,6 +1001,82 @@ aspect = 1.5
       has_message(messages, "deck.in:53:10: error: fill[1].aspect = 1.5: must be in (0, 1]"));
 }
 
+TEST(Deck, ShellIsRead) {
+  const Scene s = parse_deck_string(kMinimalDeck + R"(
+[[material]]
+name = "liner"
+density = 7850.0
+youngs_modulus = 2.1e11
+poisson_ratio = 0.3
+
+[drum]
+radius = 2.0
+material = "steel"
+
+[[drum.lifter]]
+count = 4
+height = 0.1
+width = 0.05
+
+[shell]
+thickness = 0.05
+material = "liner"
+depth = 0.1
+elements_through_thickness = 3
+)",
+                                    "shell.in");
+  ASSERT_TRUE(s.shell.present);
+  EXPECT_EQ(s.shell.thickness, 0.05);
+  EXPECT_EQ(s.shell.material, "liner");
+  EXPECT_EQ(s.shell.depth, 0.1);
+  EXPECT_EQ(s.shell.elements_through_thickness, 3);
+  EXPECT_FALSE(s.shell.element_size.has_value()) << "the thickness, by default";
+  EXPECT_FALSE(parse_deck_string(kMinimalDeck, "bare.in").shell.present);
+}
+
+TEST(DeckErrors, ShellKeys) {
+  const std::string drum = R"(
+[drum]
+radius = 1.0
+material = "steel"
+)";
+  const std::string lifter = R"(
+[[drum.lifter]]
+count = 4
+height = 0.1
+width = 0.05
+)";
+  // Without a drum; without lifters; on a polygon; a wall too thick; missing keys.
+  EXPECT_TRUE(has_message(deck_errors(kMinimalDeck + "[shell]\nthickness = 0.05\ndepth = 0.1\n"),
+                          "deck.in:11:1: error: a [shell] needs a [drum]: it is the "
+                          "drum's wall"));
+  EXPECT_TRUE(
+      has_message(deck_errors(kMinimalDeck + drum + "[shell]\nthickness = 0.05\ndepth = 0.1\n"),
+                  "deck.in:15:1: error: a [shell] reports per lifter bar (lifters.csv): the drum "
+                  "needs [[drum.lifter]]"));
+  EXPECT_TRUE(
+      has_message(deck_errors(kMinimalDeck + drum + "sides = 8\n" + lifter +
+                              "[shell]\nthickness = 0.05\ndepth = 0.1\n"),
+                  "deck.in:21:1: error: a [shell] needs a round drum (drum.sides = 0); the drum is "
+                  "a 8-gon"));
+  EXPECT_TRUE(has_message(
+      deck_errors(kMinimalDeck + drum + lifter + "[shell]\nthickness = 0.5\ndepth = 0.1\n"),
+      "deck.in:21:13: error: shell.thickness = 0.5: must be below half the drum radius 1 m"));
+  EXPECT_TRUE(
+      has_message(deck_errors(kMinimalDeck + drum + lifter +
+                              "[shell]\nthickness = 0.05\ndepth = 0.1\nelement_size = 1e-5\n"),
+                  "deck.in:23:16: error: shell.element_size = 1e-5: must lie between 0.000314159 m "
+                  "(20 000 elements around the ring) and a quarter of the drum radius, 0.25 m"));
+  const auto missing = deck_errors(kMinimalDeck + drum + lifter + "[shell]\nmaterial = \"rock\"\n");
+  EXPECT_TRUE(
+      has_message(missing, "deck.in:20:1: error: shell.thickness is required (a number > 0)"));
+  EXPECT_TRUE(has_message(missing, "deck.in:20:1: error: shell.depth is required (a number > 0)"));
+  EXPECT_EQ(missing.size(), 3u);
+  EXPECT_TRUE(has_message(missing,
+                          "deck.in:21:12: error: shell.material = \"rock\": no such "
+                          "material (defined: \"steel\")"));
+}
+
 TEST(DeckErrors, FillBedFilling) {
   // Beside a fill fraction, out of range, and without a drum.
   auto messages =

@@ -1482,7 +1482,7 @@ TEST(LifterLog, RowsPerBarAndARestartKeepsTheRowsUpToItsTime) {
   const std::vector<LifterLoad> bars = {{12.5, 1.0 / 3.0, -2.0, 7.25, 3},
                                         {307.0, 0.0, 0.0, 0.0, 0}};
   {
-    LifterLog log(path, true);
+    LifterLog log(path, true, false);
     log.write(0.125, bars);
     log.write(0.25, bars);
   }
@@ -1499,7 +1499,7 @@ TEST(LifterLog, RowsPerBarAndARestartKeepsTheRowsUpToItsTime) {
   // A kill in the middle of the row of t = 0.375: "0." of it is left (read as 0 s).
   { std::ofstream(path, std::ios::app) << "0."; }
   {
-    LifterLog resumed(path, true, 0.25);
+    LifterLog resumed(path, true, false, 0.25);
     resumed.write(0.375, bars);
   }
   std::vector<std::string> after;
@@ -1511,7 +1511,7 @@ TEST(LifterLog, RowsPerBarAndARestartKeepsTheRowsUpToItsTime) {
   EXPECT_EQ(std::vector<std::string>(after.begin(), after.begin() + 5), lines);
   EXPECT_EQ(after[5], "0.375,0,12.5,0.33333333333333331,-2,7.25,3");
   {
-    LifterLog earlier(path, true, 0.2);  // a checkpoint at 0.2: the rows of 0.25 and on go
+    LifterLog earlier(path, true, false, 0.2);  // a checkpoint at 0.2: the rows of 0.25 and on go
   }
   std::ifstream in(path);
   std::string line;

@@ -7,6 +7,10 @@
 #     apart; the bars' torques add up to series.csv's lifter_torque at every row; some bars
 #     carry the charge (contacts, a positive normal load);
 #   - a deck without lifters writes no lifters.csv;
+#   - with a [shell] (inputs/shell.in): lifters.csv carries the shell's columns, the same bytes
+#     on 1, 2 and 3 ranks and across a restart; a bar with no contact is barely deflected
+#     against the loaded ones; run.json's shell figures (nodal loads = wall loads); the deck
+#     without its [shell] runs the same bits (series.csv, the loads of lifters.csv);
 #   - post/plot_lifters.py draws a PNG, prints the CSV's own largest normal load as its peak
 #     (and writes it bit for bit with --json), a loaded window around the mean profile's peak,
 #     and --window keeps the rows of the last T seconds.
@@ -147,6 +151,73 @@ f = json.load(open(f"{work}/w.json"))
 kept = [r for r in rows if float(r["time"]) >= end - 0.1]
 assert f["rows"] == len(kept) < len(rows), (f["rows"], len(kept), len(rows))
 assert f["peak_normal_N"] == max(float(r["normal_N"]) for r in kept)
+PY
+
+
+# --- The shell: inputs/shell.in -------------------------------------------------------------------
+sh=$source_dir/inputs/shell.in
+srun=(--quiet --set run.duration=0.12 --set output.snapshot_interval=0)
+check "shell: run on 1 rank" "$dem2d" "$sh" "${srun[@]}" --output "$work/s1"
+check "shell: run on 2 ranks" mpirun -np 2 --oversubscribe "$dem2d" "$sh" "${srun[@]}" --output "$work/s2"
+check "shell: run on 3 ranks" mpirun -np 3 --oversubscribe "$dem2d" "$sh" "${srun[@]}" --output "$work/s3"
+check "shell: the first half on 2 ranks" mpirun -np 2 --oversubscribe "$dem2d" "$sh" "${srun[@]}" \
+  --set run.duration=0.06 --output "$work/srs"
+check "shell: resumed on 1 rank" "$dem2d" "$sh" "${srun[@]}" --output "$work/srs" \
+  --restart "$work/srs/checkpoint.h5"
+for other in s2 s3 srs; do
+  check "shell: lifters.csv s1 = $other, byte for byte" cmp "$work/s1/lifters.csv" "$work/$other/lifters.csv"
+done
+# One-way: the charge sees the rigid drum, so the deck without its [shell] (the shell's material
+# still defined) runs the same bits.
+sed '/^\[shell\]/,/^element_size/d' "$sh" > "$work/bare_shell.in"
+check "shell: the deck without its [shell]" "$dem2d" "$work/bare_shell.in" "${srun[@]}" --output "$work/s0"
+check "shell: series.csv the same bytes without the [shell]" cmp "$work/s1/series.csv" "$work/s0/series.csv"
+check "shell: lifters.csv's loads the same without the [shell]" "$py" - "$work/s1" "$work/s0" <<'PY'
+import csv, sys
+a, b = (list(csv.reader(open(f"{d}/lifters.csv"))) for d in sys.argv[1:3])
+assert len(a) == len(b) and len(b[0]) == 7, (len(a), len(b), b[0])
+assert all(x[:7] == y for x, y in zip(a, b)), "the loads differ"
+PY
+check "shell: lifters.csv's shell columns and run.json" "$py" - "$work/s1" <<'PY'
+import csv, json, sys
+d = sys.argv[1]
+rows = list(csv.reader(open(f"{d}/lifters.csv")))
+assert rows[0][7:] == ["tip_deflection_m", "von_mises_max_Pa", "root_stress_Pa"], rows[0]
+rows = [[float(x) for x in r] for r in rows[1:]]
+assert len(rows) == 8 * 121, len(rows)
+loaded = [r for r in rows if r[6] > 0 and r[3] > 0]
+free = [r for r in rows if r[6] == 0]
+assert len(loaded) > 50 and len(free) > 50, (len(loaded), len(free))
+top = max(r[7] for r in rows)
+assert top > 0, top
+# A bar the charge presses on its lifting face bends back; a bar without a contact moves only
+# with the ring, far less.
+assert sum(1 for r in loaded if r[7] > 0) > 0.9 * len(loaded)
+assert max(abs(r[7]) for r in free) < 0.2 * top, (max(abs(r[7]) for r in free), top)
+# Its root section carries nothing (no load on the bar); the ring's strain reaches into its foot.
+assert all(r[9] == 0 for r in free), "a root stress in a bar without a contact"
+assert max(r[8] for r in free) < 0.2 * max(r[8] for r in rows)
+assert all(r[8] >= 0 and r[9] >= 0 for r in rows)
+shell = json.load(open(f"{d}/run.json"))["shell"]
+assert shell["depth_m"] == 0.0116 and shell["elements"] > 500, shell
+assert shell["last_nodal_load_error_N_per_m"] <= 1e-12 * shell["last_load_N_per_m"], shell
+assert shell["last_records"] > 10, shell
+print(f"{len(loaded)} loaded and {len(free)} free bar rows; peak tip {top:.3g} m")
+PY
+check "plot_lifters.py: the shell's figures" "$py" - "$source_dir/post/plot_lifters.py" \
+  "$work/s3/lifters.csv" "$work" <<'PY'
+import csv, json, subprocess, sys
+script, path, work = sys.argv[1:4]
+subprocess.run([sys.executable, script, path, "--json", f"{work}/s.json", "-o", f"{work}/s.png"],
+               check=True, capture_output=True)
+f = json.load(open(f"{work}/s.json"))
+rows = list(csv.DictReader(open(path)))
+tip = [float(r["tip_deflection_m"]) for r in rows]
+assert f["peak_tip_deflection_m"] == max(tip), f
+assert f["peak_tip_lifter"] == int(rows[tip.index(max(tip))]["lifter"])
+assert f["peak_von_mises_Pa"] == max(float(r["von_mises_max_Pa"]) for r in rows)
+assert f["peak_root_stress_Pa"] == max(float(r["root_stress_Pa"]) for r in rows)
+assert open(f"{work}/s.png", "rb").read(8) == b"\x89PNG\r\n\x1a\n"
 PY
 
 finish

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The layering rules (docs/architecture.md, "Layers"), checked on the sources and on the built
 # core library. Usage: check_layers.sh SOURCE_DIR LIBDEM2D_CORE.a
-#   core/      physics: includes only core/ and the C++ standard library; no MPI, HDF5, TOML,
-#              METIS or fmt; its library references no MPI or HDF5 symbol;
+#   core/      physics: includes only core/, the C++ standard library and Eigen; no MPI, HDF5,
+#              TOML, METIS or fmt; its library references no MPI or HDF5 symbol;
 #   parallel/  may include core/ and parallel/ (and mpi.h, metis.h), never io/ or app/;
 #   io/        may include core/, parallel/ and io/, never app/; calls no MPI function itself
 #              (the MPI_Comm handle and H5Pset_fapl_mpio for collective HDF5 are allowed);

@@ -243,6 +243,17 @@ struct SieveSpec {
   double holdup = 0.0;       // kg, overflow: the ore hold-up the mill keeps
 };
 
+// The drum's shell ring and its lifter bars as plane-strain finite elements (core/structure,
+// docs/models.md "The shell as finite elements"), loaded by the charge's wall contacts.
+struct ShellSpec {
+  bool present = false;
+  double thickness = 0.0;              // m, the ring outside the drum's circle
+  std::string material;                // empty: the drum's
+  int elements_through_thickness = 2;  // across the ring and across each bar
+  std::optional<double> element_size;  // m, along the ring; unset: the thickness
+  double depth = 0.0;                  // m, the depth of mill the slice stands for
+};
+
 struct OutputSpec {
   std::string directory = "out";
   double series_interval = 1.0e-3;
@@ -277,6 +288,7 @@ struct Scene {
   BreakageSpec breakage;
   FeedSpec feed;
   SieveSpec sieve;
+  ShellSpec shell;
   OutputSpec output;
   // Where the deck gave a value that a check after reading may refuse (core/setup/validate.hpp, the
   // fill placement), by the key's dotted path as messages name it: "run.duration" ->

@@ -102,6 +102,11 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
   const PairTable table(scene);
   // Per material: the smallest radius present (the shortest contact time: t_c ~ r).
   const std::size_t nm = scene.materials.size();
+  // The materials of the walls (a material no wall and no particle has, e.g. the shell's for its
+  // finite elements alone, sets no contact time).
+  std::vector<char> wall_material(nm, 0);
+  const Walls walls(scene);
+  for (const WallElement& e : walls.elements()) wall_material[e.material] = 1;
   std::vector<double> r_min(nm, std::numeric_limits<double>::max());
   // A shaped particle counts as the sphere of its smaller semi-axis (lighter than it, so its
   // contact times are shorter; its curvature radii are not looked at).
@@ -135,7 +140,7 @@ TimeScales time_scales(const Scene& scene, const ParticleStore& p) {
         ts.hertz = std::min(ts.hertz, t);
       };
       // The smallest sphere against a wall of material b (m* = m, R* = r).
-      shorter(contact_time(mass_a, r_min[a], e_star, v.wall), true);
+      if (wall_material[b]) shorter(contact_time(mass_a, r_min[a], e_star, v.wall), true);
       // Against the smallest sphere of material b: the pair's reduced mass and radius.
       if (r_min[b] == std::numeric_limits<double>::max()) continue;
       const double mass_b = Disc::mass(r_min[b], scene.materials[b].density);

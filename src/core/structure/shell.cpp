@@ -1,0 +1,68 @@
+#include "core/structure/shell.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "core/geometry/drum_geometry.hpp"
+#include "core/structure/fe_mesh.hpp"
+
+namespace dem2d {
+
+namespace {
+
+FeModel shell_model(const Scene& scene) {
+  const ShellSpec& s = scene.shell;
+  ShellMeshSpec spec;
+  spec.thickness = s.thickness;
+  spec.elements_through_thickness = s.elements_through_thickness;
+  spec.element_size = s.element_size.value_or(s.thickness);
+  const std::string& name = s.material.empty() ? scene.drum.material : s.material;
+  const int m = find_material(scene, name);
+  if (m < 0) throw std::invalid_argument("the shell's material " + name + " is not defined");
+  const MaterialSpec& mat = scene.materials[static_cast<std::size_t>(m)];
+  return FeModel(shell_mesh(DrumGeometry(scene.drum), spec),
+                 ElasticMaterial{mat.youngs_modulus, mat.poisson_ratio, mat.density});
+}
+
+}  // namespace
+
+Shell::Shell(const Scene& scene, const Walls& walls)
+    : model_(shell_model(scene)),
+      map_(model_.mesh(), walls.elements()),
+      centre_(scene.drum.center),
+      depth_(scene.shell.depth),
+      sense_(scene.drum.speed >= 0.0 ? 1.0 : -1.0) {
+  if (!(depth_ > 0.0)) throw std::invalid_argument("the shell's depth must be positive");
+}
+
+ShellResponse Shell::respond(std::span<const WallLoad> records, const Walls& walls,
+                             bool check) const {
+  ShellResponse out;
+  const double angle = walls.drum_angle();
+  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model_.dofs()));
+  out.records = map_.add(records, angle, centre_, depth_, f);
+  for (const WallLoad& l : records) {
+    if (walls.elements()[static_cast<std::size_t>(l.element)].part == WallPart::kWall) continue;
+    out.applied += rotate(l.force, -angle) * (-1.0 / depth_);
+  }
+  const FeVector u = model_.solve(f);
+  for (Eigen::Index k = 0; k + 1 < f.size(); k += 2) {
+    out.nodal += Vec2{f[k], f[k + 1]};
+    out.max_displacement = std::max(out.max_displacement, norm(Vec2{u[k], u[k + 1]}));
+  }
+  if (check) {
+    const FeVector r = model_.reactions(u, f);
+    for (Eigen::Index k = 0; k + 1 < r.size(); k += 2) out.reaction += Vec2{r[k], r[k + 1]};
+  }
+  const std::size_t bars = model_.mesh().bars.size();
+  out.bars.resize(bars);
+  for (std::size_t b = 0; b < bars; ++b) {
+    const BarResponse resp = model_.bar_response(b, u);
+    // tip_side is counter-clockwise; the lifting face's normal (tangential) is sense_ times it.
+    out.bars[b] = {0.0 - sense_ * resp.tip_side, resp.peak_von_mises,
+                   model_.bar_root(b, f).nominal_stress};
+  }
+  return out;
+}
+
+}  // namespace dem2d
