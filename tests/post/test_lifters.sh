@@ -302,6 +302,10 @@ for d in ("s1", "srs"):
             assert geometry.startswith("/shell/") and geometry.endswith("/points"), geometry
 print(f"{nodes} nodes, {elements} elements, {len(snaps)} snapshots; largest displacement {top:.3g} m")
 PY
+for other in s3 srs; do
+  check "shell: h5compare.py s1 = $other (the shell too)" "$py" "$source_dir/post/h5compare.py" \
+    --by-step --allow-added "$work/s1/snapshots.h5" "$work/$other/snapshots.h5"
+done
 check "shell: check_xdmf.py on snapshots.xmf (1 rank, restarted)" \
   bash -c "'$py' '$source_dir/tests/io/check_xdmf.py' '$work/s1/snapshots.xmf' &&
            '$py' '$source_dir/tests/io/check_xdmf.py' '$work/srs/snapshots.xmf'"
