@@ -1239,6 +1239,33 @@ TEST(SnapshotWriter, TheShellIsRankZerosAndAResumeTrimsItWithItsSnapshot) {
   EXPECT_EQ(std::system(command.c_str()), 0) << read_text(log);
 }
 
+// A write that fails after staging its shell (and the file's mesh) leaves nothing published; the
+// next write takes its number and writes both afresh.
+TEST(SnapshotWriter, AFailedWriteWithAShellIsReplacedByTheNext) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    writer.fail_before_dataset_for_testing(100);  // after every dataset, before the moves
+    EXPECT_THROW(write_shell_version(writer, 1, 0.1), IoError);
+    write_shell_version(writer, 2, 0.2);
+    EXPECT_EQ(writer.last_snapshot()->name, "000000");
+    EXPECT_EQ(writer.last_snapshot()->shell_nodes, 15u);
+    writer.close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(group_members(file.id, "/shell"), (std::set<std::string>{"000000"}));
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  EXPECT_EQ(read_attribute<std::int64_t>(file.id, "/shell/000000", "step", H5T_NATIVE_INT64), 2000);
+  Dims dims;
+  const auto vm = read_dataset<double>(file.id, "/shell/000000/von_mises", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(vm, test_shell(2).von_mises);
+  read_dataset<std::int64_t>(file.id, "/shell_mesh/quadrilaterals", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{8, 4}));
+}
+
 // --- Shaped particles ---------------------------------------------------------------------
 
 // Global particle k of a mixed scene at snapshot `version`: every third a disc, the others
