@@ -10,8 +10,10 @@ same. Compared: the number and names of snapshots, their time and step attribute
 ids, every per-particle dataset (id, material, position, velocity, angle, spin, radius: whatever
 the files hold; a dataset in one file only is a difference), the particles' outline polygons
 of scenes with superellipses (/outlines/NAME/points, as "outline", each particle's points
-matched by id) and the /materials table. The datasets' unit and doc attributes and /xdmf
-(ParaView helper data) are not compared.
+matched by id), the shell of runs with a [shell] (/shell/NAME's points, displacement and
+von_mises, row by row: the mesh's nodes, the same in every run of a deck; /shell_mesh once) and
+the /materials table. The datasets' unit and doc attributes and /xdmf (ParaView helper data)
+are not compared.
 With --by-step, snapshots are paired by their step attribute instead of their names: a run
 that was interrupted (which wrote a last snapshot where it stopped) and restarted compares
 with the uninterrupted run, the extra snapshot allowed by --allow-added.
@@ -140,6 +142,38 @@ def compare_snapshot(name, ga, gb, atol, report, outlines=(None, None)):
         compare_arrays(where, "outline", oa[ia], ob[ib], common, atol, report)
 
 
+def compare_shell(fa, fb, name_a, name_b, atol, report):
+    """The shell of a snapshot pair (/shell/NAME), row by row."""
+    sa = fa["shell"][name_a] if "shell" in fa and name_a in fa["shell"] else None
+    sb = fb["shell"][name_b] if "shell" in fb and name_b in fb["shell"] else None
+    if sa is None and sb is not None and report.allow_added:
+        report.added.add("shell")
+    elif (sa is None) != (sb is None):
+        report.differ(f"/shell/{name_a}: only in the {'first' if sa is not None else 'second'} file")
+    elif sa is not None:
+        for field in sorted(set(sa.keys()) | set(sb.keys())):
+            if field not in sa or field not in sb:
+                report.differ(f"/shell/{name_a}/{field}: only in one file")
+                continue
+            compare_arrays(f"/snapshots/{name_a}", f"shell/{field}", sa[field][()], sb[field][()],
+                           None, atol, report)
+
+
+def compare_shell_mesh(fa, fb, atol, report):
+    """The shell's mesh (/shell_mesh), when either file has one."""
+    ma, mb = fa.get("shell_mesh"), fb.get("shell_mesh")
+    if ma is None and mb is not None and report.allow_added:
+        report.added.add("shell_mesh")
+    elif (ma is None) != (mb is None):
+        report.differ("/shell_mesh: only in one file")
+    elif ma is not None:
+        for field in sorted(set(ma.keys()) | set(mb.keys())):
+            if field not in ma or field not in mb:
+                report.differ(f"/shell_mesh/{field}: only in one file")
+                continue
+            compare_arrays("/shell_mesh", field, ma[field][()], mb[field][()], None, atol, report)
+
+
 def compare_materials(fa, fb, atol, report):
     ma, mb = fa.get("materials"), fb.get("materials")
     if ma is None or mb is None:
@@ -198,11 +232,13 @@ def main(argv=None):
     report = Report(args.show, args.allow_added)
     with fa, fb:
         compare_materials(fa, fb, args.atol, report)
+        compare_shell_mesh(fa, fb, args.atol, report)
         common = paired_snapshots(fa, fb, args.by_step, report)
         for name_a, name_b in common:
             ga, gb = fa["snapshots"][name_a], fb["snapshots"][name_b]
             outlines = (outline_rows(fa, name_a, len(ga["id"])), outline_rows(fb, name_b, len(gb["id"])))
             compare_snapshot(name_a, ga, gb, args.atol, report, outlines)
+            compare_shell(fa, fb, name_a, name_b, args.atol, report)
     if report.differences == 0:
         what = "bit-identical" if args.atol == 0 else f"identical within atol = {args.atol:g}"
         added = f"; datasets only in the second file: {', '.join(sorted(report.added))}" if report.added else ""

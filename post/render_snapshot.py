@@ -11,9 +11,12 @@ The drum is drawn when its radius is known: from --drum-radius / --drum-center, 
 run.json beside the HDF5 file ({"deck": {"drum": {"radius": R, "center": [x, y]}}}).
 Particles are drawn at their true size (in data units), so a packing looks like a packing:
 discs as circles of their radius, superellipses (snapshots with semi_axis_a, semi_axis_b and
-exponent) as their outline polygons (64 points on the curve) turned by their angle. --json
-writes, for the picture drawn, each circle (id, centre, radius) and each outline polygon (id
-and its vertices as drawn), so that a test can measure them.
+exponent) as their outline polygons (64 points on the curve) turned by their angle. A run with
+a [shell] also has the shell's finite elements in its snapshots (/shell, /shell_mesh): the
+shell ring and lifter bars are drawn as the mesh's quadrilaterals, at rest, coloured by their
+nodes' mean von Mises stress. --json writes, for the picture drawn, each circle (id, centre,
+radius) and each outline polygon (id and its vertices as drawn), and the number of shell cells
+drawn, so that a test can measure them.
 """
 
 import argparse
@@ -28,7 +31,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.collections import EllipseCollection  # noqa: E402
+from matplotlib.collections import EllipseCollection, PolyCollection  # noqa: E402
 from matplotlib.patches import Circle, Patch  # noqa: E402
 
 import millplot  # noqa: E402
@@ -53,7 +56,18 @@ def read_snapshot(f, name):
         "radius": np.asarray(g["radius"][()]),
         "material": np.asarray(g["material"][()]),
         "shape": millplot.read_shape(g),
+        "shell": read_shell(f, name),
     }
+
+
+def read_shell(f, name):
+    """The shell of snapshot `name` (runs with a [shell]): its nodes, von Mises stress and the
+    mesh's quadrilaterals; None without one."""
+    if "shell" not in f or name not in f["shell"] or "shell_mesh" not in f:
+        return None
+    g = f["shell"][name]
+    return {"points": np.asarray(g["points"][()]), "von_mises": np.asarray(g["von_mises"][()]),
+            "quadrilaterals": np.asarray(f["shell_mesh/quadrilaterals"][()])}
 
 
 def drum_geometry(args):
@@ -150,6 +164,11 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi, drawn=None):
         margin = 0.05 * radius
         ax.set_xlim(center[0] - radius - margin, center[0] + radius + margin)
         ax.set_ylim(center[1] - radius - margin, center[1] + radius + margin)
+    elif snap["shell"] is not None:
+        lo, hi = snap["shell"]["points"].min(axis=0), snap["shell"]["points"].max(axis=0)
+        margin = 0.05 * float((hi - lo).max())
+        ax.set_xlim(lo[0] - margin, hi[0] + margin)
+        ax.set_ylim(lo[1] - margin, hi[1] + margin)
     elif len(r):  # radius: the bounding circle of a superellipse
         lo = (pos - r[:, None]).min(axis=0)
         hi = (pos + r[:, None]).max(axis=0)
@@ -157,6 +176,22 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi, drawn=None):
         ax.set_xlim(lo[0] - margin, hi[0] + margin)
         ax.set_ylim(lo[1] - margin, hi[1] + margin)
 
+    shell_cells = 0
+    if snap["shell"] is not None:
+        sh = snap["shell"]
+        if drum is not None:  # the drum's circle is the shell's inner surface: room for its outside
+            x0, x1 = ax.get_xlim()
+            y0, y1 = ax.get_ylim()
+            lo, hi = sh["points"].min(axis=0), sh["points"].max(axis=0)
+            pad = 0.02 * (x1 - x0)
+            ax.set_xlim(min(x0, lo[0] - pad), max(x1, hi[0] + pad))
+            ax.set_ylim(min(y0, lo[1] - pad), max(y1, hi[1] + pad))
+        quads = sh["quadrilaterals"]
+        cells = PolyCollection(sh["points"][quads], array=sh["von_mises"][quads].mean(axis=1) / 1e6,
+                               cmap="inferno", edgecolors="none", zorder=0)
+        ax.add_collection(cells)
+        fig.colorbar(cells, ax=ax, shrink=0.8, label="shell: von Mises [MPa]")
+        shell_cells = len(quads)
     if len(r):
         style = dict(edgecolors="0.15", linewidths=0.3)
         if color == "speed":
@@ -181,6 +216,7 @@ def render(snap, materials, drum, color, speed_max, out, size, dpi, drawn=None):
     plt.close(fig)
     if drawn is not None:
         drawn.append(drawn_shapes(snap, drawn_collections if len(r) else []))
+        drawn[-1]["shell_cells"] = shell_cells
 
 
 def write_drawn(path, drawn):

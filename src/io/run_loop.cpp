@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <csignal>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -63,7 +64,15 @@ bool RunLoop::observes_step(std::int64_t next) const {
 }
 
 void RunLoop::snapshot() {
-  snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), wall_outlines(sim_.walls()));
+  const std::optional<ShellField> field = lifters_.shell_field(sim_);  // rank 0's
+  ShellSnapshot shell;
+  if (field) {
+    const FeMesh& mesh = lifters_.shell()->model().mesh();
+    shell = {field->position, field->displacement, field->von_mises, mesh.elements,
+             mesh.element_bar};
+  }
+  snapshots_.write(sim_.particles(), sim_.time(), sim_.step_count(), wall_outlines(sim_.walls()),
+                   {}, field ? &shell : nullptr);
   last_snapshot_time_ = sim_.time();
   if (sim_.spectra()) write_collisions(MPI_COMM_WORLD, scene_.output.directory, *sim_.spectra());
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -153,6 +154,17 @@ std::vector<ShellContact> shell_contacts(const Simulation& sim) {
   return out;
 }
 
+// Collective: every rank's records on the shell and the bars from the last force evaluation, in
+// (particle id, element) order, as the shell takes them (Shell::respond, Shell::field).
+std::vector<WallLoad> gathered_shell_records(const Simulation& sim) {
+  const std::vector<ShellContact> all = gather_in_key_order<ShellCodec>(shell_contacts(sim));
+  std::vector<WallLoad> records;
+  records.reserve(all.size());
+  for (const ShellContact& c : all)
+    records.push_back({c.element, 0, c.point, c.force, 0.0, Vec2{}});
+  return records;
+}
+
 }  // namespace
 
 LifterOutput::LifterOutput(const Scene& scene, const Simulation& sim, bool resumed) {
@@ -180,24 +192,25 @@ void LifterOutput::write(const Simulation& sim) {
   if (!bars_) return;
   const std::vector<LifterContact> all = gather_in_key_order<LifterCodec>(
       bars_->contacts(sim.contacts().wall_loads(), sim.particles(), sim.walls()));
-  std::vector<ShellContact> on_shell;
-  if (has_shell_) on_shell = gather_in_key_order<ShellCodec>(shell_contacts(sim));
+  std::vector<WallLoad> on_shell;
+  if (has_shell_) on_shell = gathered_shell_records(sim);
   std::string error;
   try {
     if (mpi::rank(MPI_COMM_WORLD) == 0) {
-      if (shell_) {
-        std::vector<WallLoad> records;
-        records.reserve(on_shell.size());
-        for (const ShellContact& c : on_shell)
-          records.push_back({c.element, 0, c.point, c.force, 0.0, Vec2{}});
-        response_ = shell_->respond(records, sim.walls());
-      }
+      if (shell_) response_ = shell_->respond(on_shell, sim.walls());
       log_->write(sim.time(), bars_->sum(all, sim.walls()), response_.bars);
     }
   } catch (const IoError& e) {
     error = e.what();
   }
   mpi::agree_on_failure<IoError>(MPI_COMM_WORLD, error);
+}
+
+std::optional<ShellField> LifterOutput::shell_field(const Simulation& sim) const {
+  if (!has_shell_) return std::nullopt;
+  const std::vector<WallLoad> records = gathered_shell_records(sim);
+  if (!shell_) return std::nullopt;
+  return shell_->field(records, sim.walls());
 }
 
 }  // namespace dem2d

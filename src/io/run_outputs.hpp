@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "core/geometry/lifter_loads.hpp"
 #include "core/run/simulation.hpp"
@@ -53,6 +54,10 @@ class LifterOutput {
   void write(const Simulation& sim);  // collective
   // The shell's model on rank 0 (null elsewhere and without a [shell]).
   const Shell* shell() const { return shell_.get(); }
+  // Collective: the shell's displacement and stress under the last force evaluation's wall
+  // loads (gathered and solved as for a row), on rank 0; std::nullopt elsewhere and without a
+  // [shell].
+  std::optional<ShellField> shell_field(const Simulation& sim) const;
   // The shell's response at the last row written (rank 0).
   const ShellResponse& last_response() const { return response_; }
 

@@ -18,6 +18,16 @@ inline const std::string kSnapshotsGroup = "/snapshots";
 inline const std::string kWallsGroup = "/walls";
 inline const std::string kOutlinesGroup = "/outlines";
 inline const std::string kXdmfGroup = "/xdmf";
+// The shell's finite elements (runs with a [shell] only): its state at each snapshot, and its
+// mesh, the same for the whole run, once per file.
+inline const std::string kShellGroup = "/shell";
+inline const std::string kShellMeshGroup = "/shell_mesh";
+// The mesh's datasets: its 9-node elements, each element's bar, and the split of each element
+// into four 4-node quadrilaterals that snapshots.xmf draws (with each quadrilateral's bar).
+inline const std::string kShellElements = kShellMeshGroup + "/elements";
+inline const std::string kShellElementBar = kShellMeshGroup + "/element_bar";
+inline const std::string kShellQuadrilaterals = kShellMeshGroup + "/quadrilaterals";
+inline const std::string kShellQuadrilateralBar = kShellMeshGroup + "/quadrilateral_bar";
 
 // The dataset that gives the XDMF grids their geometry; every other one is a point attribute.
 inline constexpr const char* kGeometry = "position";

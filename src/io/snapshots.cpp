@@ -31,6 +31,12 @@ using snapshot_layout::kGeometry;
 using snapshot_layout::kMaterial;
 using snapshot_layout::kOutlinesGroup;
 using snapshot_layout::kOutlineVertices;
+using snapshot_layout::kShellElementBar;
+using snapshot_layout::kShellElements;
+using snapshot_layout::kShellGroup;
+using snapshot_layout::kShellMeshGroup;
+using snapshot_layout::kShellQuadrilateralBar;
+using snapshot_layout::kShellQuadrilaterals;
 using snapshot_layout::kSnapshotsGroup;
 using snapshot_layout::kWallsGroup;
 using snapshot_layout::kXdmfGroup;
@@ -52,6 +58,8 @@ const std::string kStagingGroup = "/incomplete";
 std::string staged_walls(const std::string& name) { return kStagingGroup + "/walls_" + name; }
 // Where snapshot NAME's particle outlines are staged.
 std::string staged_outlines(const std::string& name) { return kStagingGroup + "/outlines_" + name; }
+// Where snapshot NAME's shell is staged.
+std::string staged_shell(const std::string& name) { return kStagingGroup + "/shell_" + name; }
 
 // The n of a member "polyvertex_n" of /xdmf; std::nullopt for another name.
 std::optional<std::uint64_t> polyvertex_size(const std::string& member) {
@@ -238,8 +246,9 @@ SnapshotWriter::WallData SnapshotWriter::wall_data(std::span<const std::vector<V
 }
 
 // rank 0's outline rows and whether this write syncs the file to disk (rank 0's clock), for
-// every rank: `header` is {points, segments, sync}.
-void SnapshotWriter::sync_due(std::array<int, 3>& header) {
+// every rank: `header` is {points, segments, sync, shell nodes, shell elements, shell
+// fields not matching the mesh}.
+void SnapshotWriter::sync_due(std::array<int, 6>& header) {
   const auto now = std::chrono::steady_clock::now();
   header[2] = now - last_sync_ >= kSyncInterval ? 1 : 0;
   mpi::broadcast(comm_, header, 0);
@@ -248,15 +257,27 @@ void SnapshotWriter::sync_due(std::array<int, 3>& header) {
 
 void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t step,
                            std::span<const std::vector<Vec2>> walls,
-                           std::span<const ExtraField> extra) {
+                           std::span<const ExtraField> extra, const ShellSnapshot* shell) {
   if (closed_) throw std::logic_error("SnapshotWriter::write after close");
   SnapshotInfo record = describe(p, time, step, extra);
   const WallData outline = wall_data(walls);
-  std::array<int, 3> header{static_cast<int>(outline.points.size() / 2),
-                            static_cast<int>(outline.segments.size() / 2), 0};
-  sync_due(header);  // rank 0's outline is written
+  const bool has_shell = shell != nullptr && !shell->position.empty() && !shell->elements.empty();
+  const bool bad_shell = has_shell && (shell->displacement.size() != shell->position.size() ||
+                                       shell->von_mises.size() != shell->position.size() ||
+                                       shell->element_bar.size() != shell->elements.size());
+  std::array<int, 6> header{static_cast<int>(outline.points.size() / 2),
+                            static_cast<int>(outline.segments.size() / 2),
+                            0,
+                            has_shell ? static_cast<int>(shell->position.size()) : 0,
+                            has_shell ? static_cast<int>(shell->elements.size()) : 0,
+                            bad_shell ? 1 : 0};
+  sync_due(header);  // rank 0's outline and shell are written
+  if (header[5] != 0)
+    throw std::invalid_argument("SnapshotWriter: the shell's fields do not match its mesh");
   record.wall_points = static_cast<std::uint64_t>(header[0]);
   record.wall_segments = static_cast<std::uint64_t>(header[1]);
+  record.shell_nodes = static_cast<std::uint64_t>(header[3]);
+  record.shell_elements = static_cast<std::uint64_t>(header[4]);
   std::uint64_t row_bytes = 0;
   for (const SnapshotDataset& d : record.datasets)
     row_bytes += d.columns * (d.type == "int32" ? 4 : 8);
@@ -266,16 +287,18 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
     row_bytes += 8 * kOutlineVertices;  // the outline's points (float x, y)
     if (!polygon_sizes_.contains({kOutlineVertices, total})) row_bytes += 8 * kOutlineVertices;
   }
+  const std::uint64_t shell_bytes =
+      40 * record.shell_nodes + (shell_mesh_written_ ? 0 : 240 * record.shell_elements);
   ensure_free_space(comm_, h5_path_,
                     total * row_bytes + 16 * (record.wall_points + record.wall_segments) +
-                        2048 * (record.datasets.size() + 2) + 16384);
+                        shell_bytes + 2048 * (record.datasets.size() + 2) + 16384);
   std::string error;
   try {
     if (!file_) file_.emplace(h5::ParallelFile::open(comm_, h5_path_));
     if (failed_) clear_failed_write(record.name);
     const h5::RowRange rows = h5::row_range(comm_, p.n_owned());
     record.particles = rows.total;
-    stage(kStagingGroup + "/" + record.name, record, rows, p, extra, outline);
+    stage(kStagingGroup + "/" + record.name, record, rows, p, extra, outline, shell);
   } catch (const IoError& e) {
     error = e.what();
   }
@@ -285,6 +308,7 @@ void SnapshotWriter::write(const ParticleStore& p, double time, std::int64_t ste
   if (record.particles > 0) polyvertex_sizes_.insert(record.particles);
   if (record.outline_vertices > 0)
     polygon_sizes_.insert({record.outline_vertices, record.particles});
+  if (record.shell_nodes > 0) shell_mesh_written_ = true;
   last_ = record;
   ++written_;
   ++next_index_;
@@ -308,6 +332,8 @@ std::optional<std::vector<SnapshotInfo>> SnapshotWriter::publish(const SnapshotI
       file_->move_link(staged_walls(record.name), kWallsGroup + "/" + record.name);
     if (record.outline_vertices > 0)  // likewise its particles' outlines
       file_->move_link(staged_outlines(record.name), kOutlinesGroup + "/" + record.name);
+    if (record.shell_nodes > 0)  // and its shell
+      file_->move_link(staged_shell(record.name), kShellGroup + "/" + record.name);
     file_->move_link(kStagingGroup + "/" + record.name, kSnapshotsGroup + "/" + record.name);
     for (auto& [key, stored] : pending_) stored_[key] = std::move(stored);
     pending_.clear();
@@ -337,10 +363,13 @@ void SnapshotWriter::agree(const std::string& local_error) {
 // recorded; a connectivity dataset no recorded snapshot uses), so the write can start afresh.
 void SnapshotWriter::clear_failed_write(const std::string& name) {
   const bool outlines = file_->link_exists(kOutlinesGroup);
+  const bool shells = file_->link_exists(kShellGroup);
   for (const std::string& g :
-       {kStagingGroup + "/" + name, staged_walls(name), staged_outlines(name),
-        kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name, kOutlinesGroup + "/" + name}) {
+       {kStagingGroup + "/" + name, staged_walls(name), staged_outlines(name), staged_shell(name),
+        kSnapshotsGroup + "/" + name, kWallsGroup + "/" + name, kOutlinesGroup + "/" + name,
+        kShellGroup + "/" + name}) {
     if (g.starts_with(kOutlinesGroup + "/") && !outlines) continue;
+    if (g.starts_with(kShellGroup + "/") && !shells) continue;
     if (file_->link_exists(g)) file_->remove_link(g);
     std::erase_if(stored_, [&](const auto& s) { return s.second.path.starts_with(g + "/"); });
   }
@@ -350,6 +379,8 @@ void SnapshotWriter::clear_failed_write(const std::string& name) {
     if ((n && !polyvertex_sizes_.contains(*n)) || (polygon && !polygon_sizes_.contains(*polygon)))
       file_->remove_link(kXdmfGroup + "/" + member);
   }
+  if (!shell_mesh_written_ && file_->link_exists(kShellMeshGroup))
+    file_->remove_link(kShellMeshGroup);  // no published snapshot uses it
   failed_ = false;
 }
 
@@ -357,7 +388,8 @@ void SnapshotWriter::clear_failed_write(const std::string& name) {
 // outline (staged_walls).
 void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
                            const h5::RowRange& rows, const ParticleStore& p,
-                           std::span<const ExtraField> extra, const WallData& walls) {
+                           std::span<const ExtraField> extra, const WallData& walls,
+                           const ShellSnapshot* shell) {
   file_->create_group(group, /*track_order=*/true);  // resume() reads the datasets in order
   file_->write_attribute(group, "time", record.time);
   file_->write_attribute(group, "step", record.step);
@@ -369,6 +401,7 @@ void SnapshotWriter::stage(const std::string& group, const SnapshotInfo& record,
     if (!polygon_sizes_.contains({record.outline_vertices, rows.total}))
       write_polygons(record.outline_vertices, rows);
   }
+  if (record.shell_nodes > 0) write_shell(staged_shell(record.name), record, shell);
   if (fail_before_dataset_) {  // testing: past the last dataset, fail before the flush
     fail_before_dataset_.reset();
     throw IoError(fmt::format("{}: cannot close '{}': injected failure", h5_path_, group));
@@ -481,6 +514,86 @@ void SnapshotWriter::write_walls(const std::string& group, const SnapshotInfo& r
   }
 }
 
+// The shell's state at snapshot `record` as the group `group`: its time and step, and per node
+// (rows of FeMesh::nodes) the position, displacement and von Mises stress; rank 0's. With the
+// file's first such snapshot, the mesh too (write_shell_mesh).
+void SnapshotWriter::write_shell(const std::string& group, const SnapshotInfo& record,
+                                 const ShellSnapshot* shell) {
+  const ShellSnapshot none{};
+  const ShellSnapshot& s = rank_ == 0 && shell != nullptr ? *shell : none;
+  if (!file_->link_exists(kShellGroup)) file_->create_group(kShellGroup);
+  file_->create_group(group);
+  file_->write_attribute(group, "time", record.time);
+  file_->write_attribute(group, "step", record.step);
+  const h5::RowRange rows = h5::rank0_rows(comm_, record.shell_nodes);
+  const auto xy = [&](std::span<const Vec2> v) {
+    std::vector<double> out(2 * rows.count);
+    for (std::size_t k = 0; k < rows.count; ++k) {
+      out[2 * k] = v[k].x;
+      out[2 * k + 1] = v[k].y;
+    }
+    return out;
+  };
+  const auto describe = [&](const std::string& name, const char* unit, const char* doc) {
+    file_->write_attribute(name, "unit", std::string(unit));
+    file_->write_attribute(name, "doc", std::string(doc));
+  };
+  file_->write_rows(group + "/points", rows, xy(s.position).data(), 2);
+  describe(group + "/points", "m",
+           "x and y of the mesh's nodes at rest, lab frame (the drum frame's mesh turned by the "
+           "drum's angle about its centre)");
+  file_->write_rows(group + "/displacement", rows, xy(s.displacement).data(), 2);
+  describe(group + "/displacement", "m",
+           "the nodes' displacement under the snapshot's wall loads, lab frame");
+  std::vector<double> von_mises(s.von_mises.begin(),
+                                s.von_mises.begin() + static_cast<std::ptrdiff_t>(rows.count));
+  file_->write_rows(group + "/von_mises", rows, von_mises.data());
+  describe(group + "/von_mises", "Pa",
+           "von Mises stress at the nodes, the elements' values extrapolated from their Gauss "
+           "points and averaged over the elements sharing the node");
+  if (!shell_mesh_written_ && !file_->link_exists(kShellMeshGroup)) write_shell_mesh(record, shell);
+}
+
+// /shell_mesh: the elements (E x 9 rows of /shell/NNNNNN/points, the 9-node order of
+// core/structure/fe_mesh.hpp), each element's bar, and each element split into four 4-node
+// quadrilaterals over its nodes, rows 4 e .. 4 e + 3 for element e (with their bars); rank 0's.
+void SnapshotWriter::write_shell_mesh(const SnapshotInfo& record, const ShellSnapshot* shell) {
+  const ShellSnapshot none{};
+  const ShellSnapshot& s = rank_ == 0 && shell != nullptr ? *shell : none;
+  // The quadrilaterals of a 9-node element, counter-clockwise like it: corner, mid-side, centre,
+  // mid-side, one per corner.
+  static constexpr std::array<std::array<int, 4>, 4> kQuarters{
+      {{0, 4, 8, 7}, {4, 1, 5, 8}, {8, 5, 2, 6}, {7, 8, 6, 3}}};
+  const h5::RowRange rows = h5::rank0_rows(comm_, record.shell_elements);
+  const h5::RowRange quad_rows = h5::rank0_rows(comm_, 4 * record.shell_elements);
+  std::vector<std::int64_t> elements, bars, quads, quad_bars;
+  for (std::size_t e = 0; e < rows.count; ++e) {
+    for (const int node : s.elements[e]) elements.push_back(node);
+    bars.push_back(s.element_bar[e]);
+    for (const std::array<int, 4>& q : kQuarters) {
+      for (const int corner : q) quads.push_back(s.elements[e][static_cast<std::size_t>(corner)]);
+      quad_bars.push_back(s.element_bar[e]);
+    }
+  }
+  file_->create_group(kShellMeshGroup);
+  const auto describe = [&](const std::string& name, const char* doc) {
+    file_->write_attribute(name, "unit", std::string("1"));
+    file_->write_attribute(name, "doc", std::string(doc));
+  };
+  file_->write_rows(kShellElements, rows, elements.data(), 9);
+  describe(kShellElements,
+           "the 9-node elements as rows of the shell's points: corners, mid-sides, centre, "
+           "counter-clockwise");
+  file_->write_rows(kShellElementBar, rows, bars.data());
+  describe(kShellElementBar, "each element's lifter bar (0, 1, ...), -1 for the shell ring");
+  file_->write_rows(kShellQuadrilaterals, quad_rows, quads.data(), 4);
+  describe(kShellQuadrilaterals,
+           "each element split into four 4-node quadrilaterals over its 9 nodes, rows 4 e to "
+           "4 e + 3 for element e");
+  file_->write_rows(kShellQuadrilateralBar, quad_rows, quad_bars.data());
+  describe(kShellQuadrilateralBar, "each quadrilateral's lifter bar, -1 for the shell ring");
+}
+
 // /xdmf/polyvertex_N for N = rows.total: 0, 1, ..., N - 1, each rank writing its rows.
 void SnapshotWriter::write_polyvertex(const h5::RowRange& rows) {
   std::vector<std::int64_t> index(rows.count);
@@ -564,6 +677,7 @@ std::vector<SnapshotInfo> SnapshotWriter::drop_and_read(double last_time) {
   reconcile_walls(kept);
   reconcile_outlines(kept);
   reconcile_polygons(kept);
+  reconcile_shell(kept);
   return kept;
 }
 
@@ -581,6 +695,8 @@ std::vector<SnapshotInfo> SnapshotWriter::published_records() const {
     if (file_->link_exists(kWallsGroup + "/" + name)) read_walls(out.back());
     if (file_->link_exists(kOutlinesGroup) && file_->link_exists(kOutlinesGroup + "/" + name))
       read_outlines(out.back());
+    if (file_->link_exists(kShellGroup) && file_->link_exists(kShellGroup + "/" + name))
+      read_shell(out.back());
   }
   return out;
 }
@@ -671,6 +787,54 @@ void SnapshotWriter::read_outlines(SnapshotInfo& record) const {
     throw IoError(fmt::format("{}: cannot resume: '{}/{}' is not the outlines of its snapshot",
                               h5_path_, kOutlinesGroup, record.name));
   record.outline_vertices = k;
+}
+
+// resume(): records the shell of every kept snapshot that has one and removes the others (those
+// of dropped snapshots, or left by a write that failed between its moves); removes /shell_mesh
+// when no kept snapshot has a shell (the next one writes it again).
+void SnapshotWriter::reconcile_shell(std::vector<SnapshotInfo>& kept) {
+  if (file_->link_exists(kShellGroup)) {
+    std::map<std::string, SnapshotInfo*> by_name;
+    for (SnapshotInfo& r : kept) by_name[r.name] = &r;
+    for (const std::string& member : file_->group_members(kShellGroup)) {
+      const auto it = by_name.find(member);
+      if (it == by_name.end())
+        file_->remove_link(kShellGroup + "/" + member);
+      else
+        read_shell(*it->second);
+    }
+  }
+  shell_mesh_written_ = std::any_of(kept.begin(), kept.end(),
+                                    [](const SnapshotInfo& r) { return r.shell_nodes > 0; });
+  if (!shell_mesh_written_ && file_->link_exists(kShellMeshGroup))
+    file_->remove_link(kShellMeshGroup);
+}
+
+// The rows of /shell/NAME's datasets and of the mesh's elements into `record` (NAME its name).
+// Throws IoError for a group that is not the shell of a snapshot.
+void SnapshotWriter::read_shell(SnapshotInfo& record) const {
+  const std::string group = kShellGroup + "/" + record.name;
+  const auto shape = [&](const std::string& path) {
+    return file_->link_exists(path) ? file_->dataset_shape(path) : h5::ParallelFile::DatasetShape{};
+  };
+  const h5::ParallelFile::DatasetShape points = shape(group + "/points");
+  const h5::ParallelFile::DatasetShape displacement = shape(group + "/displacement");
+  const h5::ParallelFile::DatasetShape von_mises = shape(group + "/von_mises");
+  const h5::ParallelFile::DatasetShape elements = shape(kShellElements);
+  const h5::ParallelFile::DatasetShape quads = shape(kShellQuadrilaterals);
+  const bool ok = points.type == "double" && points.columns == 2 && points.rows > 0 &&
+                  displacement.type == "double" && displacement.columns == 2 &&
+                  displacement.rows == points.rows && von_mises.type == "double" &&
+                  von_mises.columns == 1 && von_mises.rows == points.rows &&
+                  elements.type == "int64" && elements.columns == 9 && elements.rows > 0 &&
+                  quads.type == "int64" && quads.columns == 4 && quads.rows == 4 * elements.rows &&
+                  file_->link_exists(kShellElementBar) &&
+                  file_->link_exists(kShellQuadrilateralBar);
+  if (!ok)
+    throw IoError(
+        fmt::format("{}: cannot resume: '{}' is not the shell of its snapshot", h5_path_, group));
+  record.shell_nodes = points.rows;
+  record.shell_elements = elements.rows;
 }
 
 // resume(): keeps the /xdmf/polygon_K_N the kept snapshots use, removes the others and writes

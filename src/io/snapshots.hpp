@@ -28,8 +28,19 @@
 //       points   (N K x 2 float, m)      K = snapshot_layout::kOutlineVertices points of each
 //                                        particle's curve (core/shape/outline.hpp), lab frame,
 //                                        rows i K .. i K + K - 1 the particle of row i
-//   /incomplete/NNNNNN, /incomplete/walls_NNNNNN, /incomplete/outlines_NNNNNN
-//                                        the snapshot being written and its outlines (staging);
+//   /shell/NNNNNN                        runs with a [shell] only, when write() was given one:
+//                                        attributes time, step;
+//       points   (M x 2 double, m)       the mesh's nodes at rest, lab frame (turned with the drum)
+//       displacement (M x 2 double, m)   the nodes' displacement, lab frame
+//       von_mises (M double, Pa)         the nodal von Mises stress
+//   /shell_mesh                          the mesh, once per file (the first snapshot with a shell):
+//       elements (E x 9 int64)           the 9-node elements as rows of the shell's points
+//       element_bar (E int64)            each element's bar, -1 for the ring
+//       quadrilaterals (4 E x 4 int64)   each element as four 4-node quadrilaterals over its
+//                                        nodes (snapshots.xmf's topology), rows 4 e .. 4 e + 3
+//       quadrilateral_bar (4 E int64)    each quadrilateral's bar
+//   /incomplete/NNNNNN, /incomplete/walls_NNNNNN, /incomplete/outlines_NNNNNN,
+//   /incomplete/shell_NNNNNN             the snapshot being written and its outlines (staging);
 //                                        empty between writes, except after a failed write
 //   /xdmf/polyvertex_N                   int64 0..N-1, the connectivity snapshots.xmf uses for
 //                                        its Polyvertex topology (one per particle count N)
@@ -50,14 +61,17 @@
 // clock) has passed since the last sync, and close() syncs them at the end.
 //
 // snapshots.xmf (XDMF 3): a temporal collection with, per snapshot, a spatial collection at its
-// time of up to three grids: "particles", a Polyvertex grid with XY geometry from position,
+// time of up to four grids: "particles", a Polyvertex grid with XY geometry from position,
 // every other dataset as a point attribute (a Vec2 field, e.g. velocity, as a 2-component
 // Vector) and one field-data value "material: NAME" (its row) per material; "outlines" (when
 // the snapshot has /outlines), a Polygon grid of one K-node cell per particle with every
-// dataset of the snapshot as a cell attribute and the same field data; and "walls", the outline
-// as a Polyline grid of 2-node segments (absent when the snapshot has none). The domain's
+// dataset of the snapshot as a cell attribute and the same field data; "walls", the outline
+// as a Polyline grid of 2-node segments (absent when the snapshot has none); and "shell" (when
+// the snapshot has one), a Quadrilateral grid over /shell/NNNNNN/points with the displacement
+// (Vector) and von Mises as point attributes and the bar as a cell attribute. The domain's
 // <Information Name="material_names" Value="0=steel,1=ore"/> names the materials too. Checked
-// with ParaView 5.11's "XDMF Reader" and "Xdmf3 Reader S/T". It lists exactly the snapshots
+// with ParaView 5.11's "XDMF Reader" and "Xdmf3 Reader S/T" (the shell grid: against the HDF5
+// file by tests/io/check_xdmf.py only). It lists exactly the snapshots
 // under /snapshots, and only after they are there. Rank 0 creates it whole with the first
 // snapshot (through a temporary file and a rename); each later snapshot costs O(1): its <Grid>
 // and the fixed closing trailer (</Grid></Domain></Xdmf>) overwrite the old trailer in place,
@@ -117,6 +131,17 @@ struct SnapshotDataset {
 std::vector<SnapshotDataset> snapshot_datasets(const ParticleStore& particles);
 
 // What the writer knows of one snapshot of the file.
+// The shell's finite elements at a snapshot (core/structure/shell.hpp's ShellField and the
+// mesh, core/structure/fe_mesh.hpp): per node its position, displacement and von Mises stress,
+// and the mesh's elements. Rank 0's is written.
+struct ShellSnapshot {
+  std::span<const Vec2> position;                // the nodes at rest, lab frame, m
+  std::span<const Vec2> displacement;            // lab frame, m
+  std::span<const double> von_mises;             // Pa
+  std::span<const std::array<int, 9>> elements;  // Q9 node order, counter-clockwise
+  std::span<const int> element_bar;              // per element: its bar, or -1 (the ring)
+};
+
 struct SnapshotInfo {
   std::string name;  // NNNNNN: the group is /snapshots/NNNNNN
   double time = 0.0;
@@ -128,6 +153,8 @@ struct SnapshotInfo {
   // K: the points of each particle's outline, /outlines/NNNNNN/points holding N K rows; 0: no
   // outlines (a scene without shaped particles, or no particles)
   std::uint64_t outline_vertices = 0;
+  std::uint64_t shell_nodes = 0;     // rows of /shell/NNNNNN/points; 0: no shell
+  std::uint64_t shell_elements = 0;  // rows of /shell_mesh/elements (9-node elements)
 };
 
 class SnapshotWriter {
@@ -143,13 +170,14 @@ class SnapshotWriter {
   // /materials (`materials` is not used: snapshots.xmf names the file's /materials/name),
   // deletes every /snapshots group whose `time` attribute is > time + tolerance (the
   // interrupted run wrote it after the checkpoint), every staging group under /incomplete, the
-  // /xdmf/polyvertex_N and polygon_K_N no kept snapshot uses and the /walls/NNNNNN and
-  // /outlines/NNNNNN of no kept snapshot; keeps the rest, numbers the next snapshot after the
-  // highest kept one, regenerates snapshots.xmf (temporary file and rename) to list exactly the
-  // kept snapshots (removes it when none is kept), and appends in O(1) from there. When
-  // DIR/snapshots.h5 does not exist, it is the constructor above. Throws IoError on every rank,
-  // with the same message naming the file, when the file cannot be opened ("cannot open
-  // DIR/snapshots.h5: REASON") or is not a snapshot file ("DIR/snapshots.h5: cannot ...").
+  // /xdmf/polyvertex_N and polygon_K_N no kept snapshot uses, the /walls/NNNNNN, /outlines/NNNNNN
+  // and /shell/NNNNNN of no kept snapshot (and /shell_mesh when no kept snapshot has a shell);
+  // keeps the rest, numbers the next snapshot after the highest kept one, regenerates snapshots.xmf
+  // (temporary file and rename) to list exactly the kept snapshots (removes it when none is kept),
+  // and appends in O(1) from there. When DIR/snapshots.h5 does not exist, it is the constructor
+  // above. Throws IoError on every rank, with the same message naming the file, when the file
+  // cannot be opened ("cannot open DIR/snapshots.h5: REASON") or is not a snapshot file
+  // ("DIR/snapshots.h5: cannot ...").
   static std::unique_ptr<SnapshotWriter> resume(MPI_Comm comm, const std::string& directory,
                                                 const std::vector<MaterialSpec>& materials,
                                                 double time, double tolerance);
@@ -165,8 +193,12 @@ class SnapshotWriter {
   // /snapshots/NNNNNN, the file closed; then rank 0 appends its grid to snapshots.xmf. After a
   // failed write (IoError) the writer may write again: the next write first removes what the failed
   // one left and reuses its number if it did not reach /snapshots.
+  // With `shell` (rank 0's is written; the other ranks may pass null), the shell's state as
+  // /shell/NNNNNN (staged as /incomplete/shell_NNNNNN) and, with the first such snapshot of the
+  // file, its mesh as /shell_mesh; rank 0 passing null: no shell in this snapshot.
   void write(const ParticleStore& particles, double time, std::int64_t step,
-             std::span<const std::vector<Vec2>> walls = {}, std::span<const ExtraField> extra = {});
+             std::span<const std::vector<Vec2>> walls = {}, std::span<const ExtraField> extra = {},
+             const ShellSnapshot* shell = nullptr);
 
   // Syncs snapshots.h5, snapshots.xmf and the folder to disk and reports a failure (the
   // destructor neither syncs nor reports). Later writes are errors.
@@ -205,14 +237,15 @@ class SnapshotWriter {
   void write_materials(const std::vector<MaterialSpec>& materials);
   void clear_failed_write(const std::string& name);
   void stage(const std::string& group, const SnapshotInfo& record, const h5::RowRange& rows,
-             const ParticleStore& p, std::span<const ExtraField> extra, const WallData& walls);
+             const ParticleStore& p, std::span<const ExtraField> extra, const WallData& walls,
+             const ShellSnapshot* shell);
   std::optional<std::vector<SnapshotInfo>> publish(const SnapshotInfo& record, bool sync);
   bool link_if_unchanged(const std::string& key, const std::string& staged,
                          const std::string& published, const h5::RowRange& rows, const void* data,
                          std::size_t bytes);
   std::vector<SnapshotInfo> published_records() const;
   void read_walls(SnapshotInfo& record) const;
-  void sync_due(std::array<int, 3>& header);
+  void sync_due(std::array<int, 6>& header);
   void write_datasets(const std::string& group, const std::string& published,
                       const h5::RowRange& rows, const ParticleStore& p,
                       std::span<const ExtraField> extra);
@@ -221,6 +254,11 @@ class SnapshotWriter {
                       const h5::RowRange& rows, const ParticleStore& p);
   void write_polygons(std::uint64_t vertices, const h5::RowRange& rows);
   void write_walls(const std::string& group, const SnapshotInfo& record, const WallData& walls);
+  void write_shell(const std::string& group, const SnapshotInfo& record,
+                   const ShellSnapshot* shell);
+  void write_shell_mesh(const SnapshotInfo& record, const ShellSnapshot* shell);
+  void reconcile_shell(std::vector<SnapshotInfo>& kept);
+  void read_shell(SnapshotInfo& record) const;
   void agree(const std::string& local_error);                 // IoError on every rank if any failed
   std::vector<SnapshotInfo> drop_and_read(double last_time);  // resume: the file's part
   std::optional<SnapshotInfo> read_record(const std::string& name, double last_time) const;
@@ -245,7 +283,8 @@ class SnapshotWriter {
   std::uint64_t next_index_ = 0;              // NNNNNN of the next snapshot
   std::set<std::uint64_t> polyvertex_sizes_;  // n of every /xdmf/polyvertex_n written
   std::set<std::pair<std::uint64_t, std::uint64_t>> polygon_sizes_;  // (k, n): polygon_k_n
-  bool failed_ = false;  // the last write failed: clear its remains first
+  bool shell_mesh_written_ = false;  // /shell_mesh is in the file, used by a published snapshot
+  bool failed_ = false;              // the last write failed: clear its remains first
   std::optional<std::size_t> fail_before_dataset_;  // fail_before_dataset_for_testing
 };
 

@@ -23,6 +23,9 @@ namespace fs = std::filesystem;
 using snapshot_layout::kGeometry;
 using snapshot_layout::kMaterial;
 using snapshot_layout::kOutlinesGroup;
+using snapshot_layout::kShellGroup;
+using snapshot_layout::kShellQuadrilateralBar;
+using snapshot_layout::kShellQuadrilaterals;
 using snapshot_layout::kSnapshotsGroup;
 using snapshot_layout::kWallsGroup;
 using snapshot_layout::material_lookup;
@@ -193,10 +196,34 @@ std::string walls_grid(const std::string& h5, const SnapshotInfo& r) {
       hdf_item(h5, g + "/points", r.wall_points, 2, "Float", 8));
 }
 
+// The shell of one snapshot: its 9-node elements drawn as four 4-node quadrilaterals each (a
+// Quadrilateral topology, the connectivity /shell_mesh/quadrilaterals) over the XY points
+// /shell/NNNNNN/points, the displacement as a point vector, von Mises as a point scalar, and
+// each quadrilateral's bar as a cell scalar.
+std::string shell_grid(const std::string& h5, const SnapshotInfo& r) {
+  const std::string g = kShellGroup + "/" + r.name;
+  const std::uint64_t m = r.shell_nodes, quads = 4 * r.shell_elements;
+  return fmt::format(
+             "        <Grid Name=\"shell\" GridType=\"Uniform\">\n"
+             "          <Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\" "
+             "NodesPerElement=\"4\">\n"
+             "            {}\n"
+             "          </Topology>\n"
+             "          <Geometry GeometryType=\"XY\">\n"
+             "            {}\n"
+             "          </Geometry>\n",
+             quads, hdf_item(h5, kShellQuadrilaterals, quads, 4, "Int", 8),
+             hdf_item(h5, g + "/points", m, 2, "Float", 8)) +
+         attribute("Node", "displacement", h5, g + "/displacement", m, 2, "Float", 8) +
+         attribute("Node", "von_mises", h5, g + "/von_mises", m, 1, "Float", 8) +
+         attribute("Cell", "bar", h5, kShellQuadrilateralBar, quads, 1, "Int", 8) +
+         "        </Grid>\n";
+}
+
 // The <Grid> of one snapshot in snapshots.xmf, a spatial collection at the snapshot's time of
-// the particles, (when the snapshot has them) the particles' outlines and (when the snapshot
-// has one) the wall outline; `h5` is the HDF5 file's name. ParaView's three XDMF readers show
-// it as a multiblock of one block per grid at each time step.
+// the particles, (when the snapshot has them) the particles' outlines, (when the snapshot
+// has one) the wall outline and (when it has one) the shell; `h5` is the HDF5 file's name.
+// ParaView's three XDMF readers show it as a multiblock of one block per grid at each time step.
 std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
                       const std::vector<std::string>& material_names) {
   std::string text = fmt::format(
@@ -206,6 +233,7 @@ std::string xdmf_grid(const std::string& h5, const SnapshotInfo& r,
   text += particles_grid(h5, r, material_names);
   if (r.outline_vertices > 0) text += outlines_grid(h5, r, material_names);
   if (r.wall_segments > 0) text += walls_grid(h5, r);
+  if (r.shell_nodes > 0) text += shell_grid(h5, r);
   return text + "      </Grid>\n";
 }
 

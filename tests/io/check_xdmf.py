@@ -6,11 +6,12 @@
 Parses the XDMF with xml.etree and checks, with h5py: the document's shape (one temporal
 collection of spatial collections, each at a time not before the previous one, holding a
 "particles" grid, an "outlines" grid when the snapshot has particle outlines, and a "walls"
-grid when it has a wall outline); that every HDF DataItem names a dataset of the HDF5 file
+grid when it has a wall outline, and a "shell" grid when it has a shell); that every HDF DataItem names a dataset of the HDF5 file
 (path relative to the .xmf) with exactly the stated Dimensions, NumberType and Precision;
 that every XML DataItem holds as many numbers as its Dimensions say; that topologies,
 geometries and attributes agree on their sizes and the connectivity stays within the points;
-that the grids are exactly the file's /snapshots, /outlines and /walls groups; that each
+that the grids are exactly the file's /snapshots, /outlines, /walls and /shell groups
+(the shell's quadrilaterals the four quarters of each 9-node element of /shell_mesh); that each
 particle's outline polygon (its cell of the "outlines" grid, in the snapshot's row order) is
 counter-clockwise, centred on the particle's position and of the area of its superellipse
 (semi_axis_a, semi_axis_b, exponent) less the polygon's discretisation (at most 1.5 %: an
@@ -100,7 +101,8 @@ class Checker:
         nodes = int(topology.get("NodesPerElement"))
         kind = topology.get("TopologyType")
         expected = {"particles": ("Polyvertex", 1), "walls": ("Polyline", 2),
-                    "outlines": ("Polygon", max(nodes, 3))}.get(grid.get("Name"))
+                    "outlines": ("Polygon", max(nodes, 3)),
+                    "shell": ("Quadrilateral", 4)}.get(grid.get("Name"))
         if expected != (kind, nodes):
             self.fail(where, f"grid {grid.get('Name')} has topology {kind} of {nodes} nodes")
         item, cells = topology.find("DataItem"), None
@@ -120,6 +122,8 @@ class Checker:
             values = self.data_item(attribute.find("DataItem"), at, h5)
             center = attribute.get("Center")
             want_center = "Cell" if grid.get("Name") == "outlines" else "Node"
+            if grid.get("Name") == "shell" and attribute.get("Name") == "bar":
+                want_center = "Cell"
             if center == "Grid":
                 fields.append((attribute.get("Name"), values))
             elif center != want_center:
@@ -180,7 +184,7 @@ class Checker:
         if len(temporal) != 1 or temporal[0].get("CollectionType") != "Temporal":
             self.fail("/Domain", "not one temporal collection")
             return
-        last, seen_snapshots, seen_walls, seen_outlines = -math.inf, [], [], []
+        last, seen_snapshots, seen_walls, seen_outlines, seen_shell = -math.inf, [], [], [], []
         for step in temporal[0].findall("Grid"):
             where = f"/Domain/Grid/Grid[{step.get('Name')}]"
             if step.get("CollectionType") != "Spatial":
@@ -193,6 +197,10 @@ class Checker:
             snapshot = step.get("Name").removeprefix("snapshot_")
             grids = [self.grid(g, f"{where}/Grid[{g.get('Name')}]", h5) for g in step.findall("Grid")]
             kinds = [g[0] for g in grids if g]
+            if kinds and kinds[-1] == "shell":
+                seen_shell.append(snapshot)
+                self.shell(where, snapshot, grids[-1], h5)
+                kinds = kinds[:-1]
             if kinds not in (["particles"], ["particles", "walls"], ["particles", "outlines"],
                              ["particles", "outlines", "walls"]):
                 self.fail(where, f"grids {kinds}")
@@ -223,7 +231,27 @@ class Checker:
         outlines = sorted(h5["outlines"]) if "outlines" in h5 else []
         if seen_outlines != outlines:
             self.fail("/Domain/Grid", f"outlines of {seen_outlines}, the file holds {outlines}")
+        shell = sorted(h5["shell"]) if "shell" in h5 else []
+        if seen_shell != shell:
+            self.fail("/Domain/Grid", f"shell of {seen_shell}, the file holds {shell}")
         return seen_snapshots
+
+    def shell(self, where, snapshot, grid, h5):
+        """The shell grid: the nodes of /shell/NNNNNN, four quadrilaterals per element of
+        /shell_mesh/elements, each over its element's nodes, with displacement and von_mises."""
+        name, n_points, cells, fields = grid
+        if "shell_mesh" not in h5 or snapshot not in h5.get("shell", {}):
+            self.fail(where, "a shell grid without /shell_mesh or its /shell group")
+            return
+        elements = h5["shell_mesh/elements"][()]
+        quads = h5["shell_mesh/quadrilaterals"][()]
+        if n_points != h5["shell"][snapshot]["points"].shape[0] or cells != 4 * elements.shape[0]:
+            self.fail(where, f"shell of {cells} cells, {n_points} points")
+            return
+        for e in range(elements.shape[0]):
+            if set(quads[4 * e:4 * e + 4].ravel()) != set(elements[e]):
+                self.fail(where, f"element {e}'s quadrilaterals are not over its nodes")
+                return
 
 
 def check_paraview(xmf, h5, snapshots, problems):

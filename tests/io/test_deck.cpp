@@ -1383,7 +1383,7 @@ material = "steel"
   EXPECT_TRUE(has_message(messages,
                           "--set nonsense.key=1: error: unknown table [nonsense]; "
                           "valid keys: title, run, contact, material, interaction, "
-                          "drum, fill, particle, wall, breakage, feed, sieve, output"));
+                          "drum, fill, particle, wall, breakage, feed, sieve, shell, output"));
   EXPECT_EQ(messages.size(), 10u);
 }
 

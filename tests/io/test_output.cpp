@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -1107,6 +1108,162 @@ TEST(XdmfSidecar, EveryDataItemMatchesTheHdf5File) {
     write_version(writer, 3, 0, 0.0, false, true);
   }
   check("without materials");
+}
+
+// --- The shell's finite elements --------------------------------------------------------------
+
+// A shell of two 9-node elements side by side on a 5 x 3 grid of nodes (node (i, j): 5 j + i),
+// the ring's and bar 0's, its fields a function of `version`.
+struct TestShell {
+  std::vector<Vec2> position, displacement;
+  std::vector<double> von_mises;
+  std::vector<std::array<int, 9>> elements;
+  std::vector<int> element_bar{-1, 0};
+  ShellSnapshot view() const { return {position, displacement, von_mises, elements, element_bar}; }
+};
+
+TestShell test_shell(int version) {
+  TestShell s;
+  for (int j = 0; j < 3; ++j) {
+    for (int i = 0; i < 5; ++i) {
+      s.position.push_back({0.01 * i + version, 0.01 * j});
+      s.displacement.push_back({1e-7 * (i + 1) * (version + 1), -1e-7 * j});
+      s.von_mises.push_back(1e6 * (i + j + version) + 1.0 / 3.0);
+    }
+  }
+  const auto n = [](int i, int j) { return 5 * j + i; };
+  for (const int i : {0, 2})
+    s.elements.push_back({n(i, 0), n(i + 2, 0), n(i + 2, 2), n(i, 2), n(i + 1, 0), n(i + 2, 1),
+                          n(i + 1, 2), n(i, 1), n(i + 1, 1)});
+  return s;
+}
+
+// Writes particles [0, 5) of `version` with its wall outline and test_shell(version), which rank
+// 0 alone passes.
+void write_shell_version(SnapshotWriter& w, int version, double time) {
+  ParticleStore p;
+  fill(p, 5, version, [](int k) { return block_owner(k, 5); });
+  const TestShell shell = test_shell(version);
+  const ShellSnapshot view = shell.view();
+  w.write(p, time, 1000 * version, outline(version), {}, comm_rank() == 0 ? &view : nullptr);
+}
+
+// The shell is rank 0's, written with its snapshot (the mesh once per file); a resume keeps the
+// shell of the kept snapshots only; a file without a shell has no shell groups.
+TEST(SnapshotWriter, TheShellIsRankZerosAndAResumeTrimsItWithItsSnapshot) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    write_version(writer, 5, 0, 0.1, false, true);  // no shell
+    for (int v = 1; v < 4; ++v) write_shell_version(writer, v, 0.1 * (v + 1));
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  {
+    const auto writer = SnapshotWriter::resume(MPI_COMM_WORLD, dir.path(), {}, 0.25, 1e-9);
+    ASSERT_EQ(writer->snapshots_written(), 2u);
+    EXPECT_EQ(writer->last_snapshot()->shell_nodes, 15u);
+    EXPECT_EQ(writer->last_snapshot()->shell_elements, 2u);
+    write_shell_version(*writer, 5, 0.5);
+    writer->close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  ScratchDir bare;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, bare.path(), test_materials());
+    write_version(writer, 5, 0, 0.1, false, true);
+    writer.close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  {
+    H5Closer file{H5Fopen((bare / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+    ASSERT_GE(file.id, 0);
+    const std::set<std::string> top = group_members(file.id, "/");
+    EXPECT_FALSE(top.contains("shell") || top.contains("shell_mesh"));
+    EXPECT_EQ(count(read_text(bare / "snapshots.xmf"), "Name=\"shell\""), 0u);
+  }
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(group_members(file.id, "/snapshots"),
+            (std::set<std::string>{"000000", "000001", "000002"}));
+  EXPECT_EQ(group_members(file.id, "/shell"), (std::set<std::string>{"000001", "000002"}));
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  const std::pair<std::string, int> kept[] = {{"000001", 1}, {"000002", 5}};
+  for (const auto& [name, version] : kept) {
+    const TestShell want = test_shell(version);
+    const std::string g = "/shell/" + name;
+    EXPECT_EQ(read_attribute<std::int64_t>(file.id, g, "step", H5T_NATIVE_INT64), 1000 * version);
+    Dims dims;
+    const auto points = read_dataset<double>(file.id, g + "/points", H5T_NATIVE_DOUBLE, dims);
+    EXPECT_EQ(dims, (Dims{15, 2}));
+    const auto moved = read_dataset<double>(file.id, g + "/displacement", H5T_NATIVE_DOUBLE, dims);
+    EXPECT_EQ(dims, (Dims{15, 2}));
+    const auto vm = read_dataset<double>(file.id, g + "/von_mises", H5T_NATIVE_DOUBLE, dims);
+    EXPECT_EQ(dims, (Dims{15}));
+    ASSERT_EQ(points.size(), 30u);
+    ASSERT_EQ(moved.size(), 30u);
+    ASSERT_EQ(vm.size(), 15u);
+    for (std::size_t k = 0; k < 15; ++k) {
+      EXPECT_EQ(points[2 * k], want.position[k].x);
+      EXPECT_EQ(points[2 * k + 1], want.position[k].y);
+      EXPECT_EQ(moved[2 * k], want.displacement[k].x);
+      EXPECT_EQ(moved[2 * k + 1], want.displacement[k].y);
+      EXPECT_EQ(vm[k], want.von_mises[k]);
+    }
+    EXPECT_EQ(read_string_attribute(file.id, g + "/von_mises", "unit"), "Pa");
+  }
+  Dims dims;
+  const auto elements =
+      read_dataset<std::int64_t>(file.id, "/shell_mesh/elements", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{2, 9}));
+  EXPECT_EQ(elements, (std::vector<std::int64_t>{0, 2, 12, 10, 1, 7, 11, 5, 6,  //
+                                                 2, 4, 14, 12, 3, 9, 13, 7, 8}));
+  EXPECT_EQ(read_dataset<std::int64_t>(file.id, "/shell_mesh/element_bar", H5T_NATIVE_INT64, dims),
+            (std::vector<std::int64_t>{-1, 0}));
+  // The quarters of an element: the four cells of its 3 x 3 nodes, counter-clockwise.
+  const auto quads =
+      read_dataset<std::int64_t>(file.id, "/shell_mesh/quadrilaterals", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{8, 4}));
+  EXPECT_EQ(quads, (std::vector<std::int64_t>{0, 1, 6, 5, 1, 2, 7, 6, 6, 7, 12, 11, 5, 6, 11, 10,
+                                              2, 3, 8, 7, 3, 4, 9, 8, 8, 9, 14, 13, 7, 8, 13, 12}));
+  EXPECT_EQ(
+      read_dataset<std::int64_t>(file.id, "/shell_mesh/quadrilateral_bar", H5T_NATIVE_INT64, dims),
+      (std::vector<std::int64_t>{-1, -1, -1, -1, 0, 0, 0, 0}));
+  const std::string xmf = read_text(dir / "snapshots.xmf");
+  EXPECT_EQ(xml_problem(xmf), "");
+  EXPECT_EQ(count(xmf, "Name=\"shell\""), 2u);
+  const std::string log = dir / "check_xdmf.log";
+  const std::string command = "/usr/bin/python3 '" + std::string(DEM2D_SOURCE_DIR) +
+                              "/tests/io/check_xdmf.py' '" + (dir / "snapshots.xmf") + "' > '" +
+                              log + "' 2>&1";
+  EXPECT_EQ(std::system(command.c_str()), 0) << read_text(log);
+}
+
+// A write that fails after staging its shell (and the file's mesh) leaves nothing published; the
+// next write takes its number and writes both afresh.
+TEST(SnapshotWriter, AFailedWriteWithAShellIsReplacedByTheNext) {
+  ScratchDir dir;
+  {
+    SnapshotWriter writer(MPI_COMM_WORLD, dir.path(), test_materials());
+    writer.fail_before_dataset_for_testing(100);  // after every dataset, before the moves
+    EXPECT_THROW(write_shell_version(writer, 1, 0.1), IoError);
+    write_shell_version(writer, 2, 0.2);
+    EXPECT_EQ(writer.last_snapshot()->name, "000000");
+    EXPECT_EQ(writer.last_snapshot()->shell_nodes, 15u);
+    writer.close();
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  if (comm_rank() != 0) return;
+  H5Closer file{H5Fopen((dir / "snapshots.h5").c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  ASSERT_GE(file.id, 0);
+  EXPECT_EQ(group_members(file.id, "/shell"), (std::set<std::string>{"000000"}));
+  EXPECT_TRUE(group_members(file.id, "/incomplete").empty());
+  EXPECT_EQ(read_attribute<std::int64_t>(file.id, "/shell/000000", "step", H5T_NATIVE_INT64), 2000);
+  Dims dims;
+  const auto vm = read_dataset<double>(file.id, "/shell/000000/von_mises", H5T_NATIVE_DOUBLE, dims);
+  EXPECT_EQ(vm, test_shell(2).von_mises);
+  read_dataset<std::int64_t>(file.id, "/shell_mesh/quadrilaterals", H5T_NATIVE_INT64, dims);
+  EXPECT_EQ(dims, (Dims{8, 4}));
 }
 
 // --- Shaped particles ---------------------------------------------------------------------

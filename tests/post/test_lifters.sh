@@ -6,11 +6,15 @@
 #     angles are the drum's angle (its ramp) plus their places, from the bottom, 15 degrees
 #     apart; the bars' torques add up to series.csv's lifter_torque at every row; some bars
 #     carry the charge (contacts, a positive normal load);
-#   - a deck without lifters writes no lifters.csv;
+#   - a deck without lifters writes no lifters.csv; decks without a [shell] write no shell into
+#     snapshots.h5;
 #   - with a [shell] (inputs/shell.in): lifters.csv carries the shell's columns, the same bytes
 #     on 1, 2 and 3 ranks and across a restart; a bar with no contact is barely deflected
 #     against the loaded ones; run.json's shell figures (nodal loads = wall loads); the deck
-#     without its [shell] runs the same bits (series.csv, the loads of lifters.csv);
+#     without its [shell] runs the same bits (series.csv, the loads of lifters.csv); every
+#     snapshot holds the shell (nodes on the ring and bars, a finite displacement, von Mises),
+#     the same bytes on 1, 2 and 3 ranks and after the restart, and snapshots.xmf's shell grid
+#     names datasets of snapshots.h5 with their shapes;
 #   - post/plot_lifters.py draws a PNG, prints the CSV's own largest normal load as its peak
 #     (and writes it bit for bit with --json), a loaded window around the mean profile's peak,
 #     and --window keeps the rows of the last T seconds.
@@ -91,6 +95,16 @@ else
   pass "no lifters, no lifters.csv"
 fi
 
+check "decks without a [shell] write no shell into snapshots.h5" "$py" - "$work/np1" "$work/bare" <<'PY'
+import sys
+import h5py
+for d in sys.argv[1:]:
+    with h5py.File(f"{d}/snapshots.h5", "r") as f:
+        assert len(f["snapshots"]) > 0, d
+        assert "shell" not in f and "shell_mesh" not in f, (d, list(f))
+    assert 'Name="shell"' not in open(f"{d}/snapshots.xmf").read(), d
+PY
+
 # post/plot_lifters.py
 if out=$("$py" "$source_dir/post/plot_lifters.py" "$work/np3/lifters.csv" -o "$work/l.png" \
   --json "$work/l.json" 2>&1); then
@@ -156,7 +170,7 @@ PY
 
 # --- The shell: inputs/shell.in -------------------------------------------------------------------
 sh=$source_dir/inputs/shell.in
-srun=(--quiet --set run.duration=0.12 --set output.snapshot_interval=0)
+srun=(--quiet --set run.duration=0.12 --set output.snapshot_interval=0.04)
 check "shell: run on 1 rank" "$dem2d" "$sh" "${srun[@]}" --output "$work/s1"
 check "shell: run on 2 ranks" mpirun -np 2 --oversubscribe "$dem2d" "$sh" "${srun[@]}" --output "$work/s2"
 check "shell: run on 3 ranks" mpirun -np 3 --oversubscribe "$dem2d" "$sh" "${srun[@]}" --output "$work/s3"
@@ -203,6 +217,119 @@ assert shell["depth_m"] == 0.0116 and shell["elements"] > 500, shell
 assert shell["last_nodal_load_error_N_per_m"] <= 1e-12 * shell["last_load_N_per_m"], shell
 assert shell["last_records"] > 10, shell
 print(f"{len(loaded)} loaded and {len(free)} free bar rows; peak tip {top:.3g} m")
+PY
+check "shell: the snapshots' shell on 1, 2, 3 ranks and across the restart" "$py" - "$work" <<'PY'
+import json, math, os, sys
+import xml.etree.ElementTree as ET
+import h5py
+import numpy as np
+work = sys.argv[1]
+R, t, h = 0.25, 0.01, 0.02  # inputs/shell.in: drum radius, shell thickness, bar height
+centre = np.zeros(2)
+info = json.load(open(f"{work}/s1/run.json"))["shell"]
+
+def read(d):
+    out = {}
+    with h5py.File(f"{d}/snapshots.h5", "r") as f:
+        assert "shell" in f and "shell_mesh" in f, list(f)
+        assert sorted(f["shell"]) == sorted(f["snapshots"]), (list(f["shell"]), list(f["snapshots"]))
+        m = {k: f["shell_mesh"][k][()] for k in f["shell_mesh"]}
+        for name in f["snapshots"]:
+            g = f["shell"][name]
+            assert g.attrs["time"] == f["snapshots"][name].attrs["time"]
+            assert g.attrs["step"] == f["snapshots"][name].attrs["step"]
+            out[int(g.attrs["step"])] = {k: g[k][()] for k in ("points", "displacement", "von_mises")}
+    return m, out
+
+mesh, snaps = read(f"{work}/s1")
+nodes, elements = info["nodes"], info["elements"]
+assert mesh["elements"].shape == (elements, 9) and mesh["elements"].dtype == np.int64
+assert mesh["elements"].min() == 0 and mesh["elements"].max() == nodes - 1
+assert len(np.unique(mesh["elements"])) == nodes
+assert mesh["element_bar"].shape == (elements,)
+assert set(mesh["element_bar"].tolist()) == set(range(-1, 8))
+q = mesh["quadrilaterals"]
+assert q.shape == (4 * elements, 4) and mesh["quadrilateral_bar"].shape == (4 * elements,)
+assert np.array_equal(mesh["quadrilateral_bar"], np.repeat(mesh["element_bar"], 4))
+for e in (0, elements // 2, elements - 1):  # four quarters over the element's 9 nodes
+    assert sorted(set(q[4 * e:4 * e + 4].ravel())) == sorted(mesh["elements"][e]), e
+assert len(snaps) == 4, sorted(snaps)  # t = 0, 0.04, 0.08, 0.12
+top = 0.0
+for step, s in snaps.items():
+    assert s["points"].shape == (nodes, 2) and s["displacement"].shape == (nodes, 2)
+    assert s["von_mises"].shape == (nodes,)
+    r = np.hypot(*(s["points"] - centre).T)
+    assert r.min() >= R - h - 1e-9 and r.max() <= R + t + 1e-9, (r.min(), r.max())
+    assert abs(r.max() - (R + t)) < 1e-9, r.max()  # the outer surface is meshed
+    for k in ("displacement", "von_mises"):
+        assert np.all(np.isfinite(s[k])), (step, k)
+    assert np.all(s["von_mises"] >= 0)
+    u = np.hypot(*s["displacement"].T)
+    top = max(top, u.max())
+    if u.max() > 0:
+        assert s["von_mises"].max() > 0
+last = snaps[max(snaps)]
+u_last = np.hypot(*last["displacement"].T).max()
+assert 0 < u_last and abs(u_last - info["last_max_displacement_m"]) <= 1e-9 * u_last, (
+    u_last, info["last_max_displacement_m"])
+assert 0 < top < 1e-5, top  # steel under a few kilograms of charge: below a micrometre
+# The mesh turns with the drum: the same drum-frame node, turned from one snapshot to the next.
+first = snaps[min(snaps)]["points"]
+assert not np.array_equal(first, last["points"])
+assert np.allclose(np.hypot(*first.T), np.hypot(*last["points"].T), rtol=0, atol=1e-12)
+
+for other in ("s2", "s3", "srs"):
+    m2, s2 = read(f"{work}/{other}")
+    for k in mesh:
+        assert np.array_equal(mesh[k], m2[k]), (other, k)
+    common = set(snaps) & set(s2)
+    assert len(common) == 4, (other, sorted(s2))
+    for step in common:
+        for k in snaps[step]:
+            assert np.array_equal(snaps[step][k], s2[step][k]), (other, step, k)
+
+# snapshots.xmf: every snapshot has a shell grid whose DataItems are datasets of snapshots.h5
+# with the dimensions stated.
+for d in ("s1", "srs"):
+    root = ET.parse(f"{work}/{d}/snapshots.xmf").getroot()
+    with h5py.File(f"{work}/{d}/snapshots.h5", "r") as f:
+        grids = [g for g in root.iter("Grid") if g.get("Name") == "shell"]
+        assert len(grids) == len(f["snapshots"]), (d, len(grids))
+        for g in grids:
+            topo = g.find("Topology")
+            assert topo.get("TopologyType") == "Quadrilateral"
+            assert int(topo.get("NumberOfElements")) == 4 * elements
+            names = {a.get("Name"): a for a in g.findall("Attribute")}
+            assert set(names) == {"displacement", "von_mises", "bar"}, names
+            assert names["displacement"].get("AttributeType") == "Vector"
+            assert names["von_mises"].get("Center") == "Node"
+            assert names["bar"].get("Center") == "Cell"
+            for item in g.iter("DataItem"):
+                file, path = item.text.strip().split(":")
+                assert file == "snapshots.h5", file
+                dims = tuple(int(x) for x in item.get("Dimensions").split())
+                assert path in f, path
+                assert f[path].shape == dims, (path, f[path].shape, dims)
+            geometry = g.find("Geometry/DataItem").text.strip().split(":")[1]
+            assert geometry.startswith("/shell/") and geometry.endswith("/points"), geometry
+print(f"{nodes} nodes, {elements} elements, {len(snaps)} snapshots; largest displacement {top:.3g} m")
+PY
+for other in s3 srs; do
+  check "shell: h5compare.py s1 = $other (the shell too)" "$py" "$source_dir/post/h5compare.py" \
+    --by-step --allow-added "$work/s1/snapshots.h5" "$work/$other/snapshots.h5"
+done
+check "shell: check_xdmf.py on snapshots.xmf (1 rank, restarted)" \
+  bash -c "'$py' '$source_dir/tests/io/check_xdmf.py' '$work/s1/snapshots.xmf' &&
+           '$py' '$source_dir/tests/io/check_xdmf.py' '$work/srs/snapshots.xmf'"
+check "shell: render_snapshot.py draws the shell" "$py" - "$source_dir/post/render_snapshot.py" \
+  "$work/s1" <<'PY'
+import json, subprocess, sys
+script, d = sys.argv[1:3]
+subprocess.run([sys.executable, script, f"{d}/snapshots.h5", "-o", f"{d}/r.png", "--json",
+                f"{d}/r.json"], check=True, capture_output=True)
+elements = json.load(open(f"{d}/run.json"))["shell"]["elements"]
+assert json.load(open(f"{d}/r.json"))[-1]["shell_cells"] == 4 * elements
+assert open(f"{d}/r.png", "rb").read(8) == b"\x89PNG\r\n\x1a\n"
 PY
 check "plot_lifters.py: the shell's figures" "$py" - "$source_dir/post/plot_lifters.py" \
   "$work/s3/lifters.csv" "$work" <<'PY'

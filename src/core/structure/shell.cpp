@@ -1,6 +1,7 @@
 #include "core/structure/shell.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "core/geometry/drum_geometry.hpp"
@@ -61,6 +62,27 @@ ShellResponse Shell::respond(std::span<const WallLoad> records, const Walls& wal
     // tip_side is counter-clockwise; the lifting face's normal (tangential) is sense_ times it.
     out.bars[b] = {0.0 - sense_ * resp.tip_side, resp.peak_von_mises,
                    model_.bar_root(b, f).nominal_stress};
+  }
+  return out;
+}
+
+ShellField Shell::field(std::span<const WallLoad> records, const Walls& walls) const {
+  const double angle = walls.drum_angle();
+  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model_.dofs()));
+  map_.add(records, angle, centre_, depth_, f);
+  const FeVector u = model_.solve(f);
+  const FeStress stress = model_.stress(u);
+  const std::vector<Vec2>& nodes = model_.mesh().nodes;
+  ShellField out;
+  out.position.reserve(nodes.size());
+  out.displacement.reserve(nodes.size());
+  out.von_mises.reserve(nodes.size());
+  const Vec2 turn{std::cos(angle), std::sin(angle)};
+  for (std::size_t k = 0; k < nodes.size(); ++k) {
+    const auto at = static_cast<Eigen::Index>(2 * k);
+    out.position.push_back(centre_ + rotate(nodes[k], turn));
+    out.displacement.push_back(rotate(Vec2{u[at], u[at + 1]}, turn));
+    out.von_mises.push_back(stress.nodal[k].von_mises());
   }
   return out;
 }

@@ -43,6 +43,15 @@ struct ShellResponse {
   double max_displacement = 0.0;  // the largest nodal displacement, m
 };
 
+// The shell's state under a moment's wall loads, node by node (FeMesh::nodes' order), in the
+// lab frame at the walls' pose of that moment: the drum-frame mesh turned by the drum's angle
+// about its centre.
+struct ShellField {
+  std::vector<Vec2> position;      // the nodes' rest positions, m
+  std::vector<Vec2> displacement;  // m
+  std::vector<double> von_mises;   // the nodal (averaged, FeStress::nodal) von Mises stress, Pa
+};
+
 class Shell {
  public:
   // Throws std::invalid_argument when the scene's drum cannot be meshed (a polygon).
@@ -53,6 +62,9 @@ class Shell {
   // as long as the solve itself).
   ShellResponse respond(std::span<const WallLoad> records, const Walls& walls,
                         bool check = false) const;
+
+  // The displacement and nodal stress of every node under `records` (as respond()'s).
+  ShellField field(std::span<const WallLoad> records, const Walls& walls) const;
 
   const FeModel& model() const { return model_; }
   double depth() const { return depth_; }
