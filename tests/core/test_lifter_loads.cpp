@@ -115,16 +115,21 @@ TEST(LifterLoads, AnglesAreFromTheBottomInTheDrumsSenseOfRotation) {
   EXPECT_NEAR(cross(bars.radial(0, walls), bars.tangential(0, walls)), -1.0, 1e-15);
 }
 
-// 150 thesis balls in a drum turning at 1.8 rad/s with 12 bars 0.2 m high, after 1.2 s.
+// 150 thesis balls in a drum turning at 1.8 rad/s with 12 bars 0.2 m high and 0.1 m wide.
+Scene lifting_scene() {
+  Scene s = thesis_drum_scene(150, 1.8, 0, 0.1);
+  LifterSpec l;
+  l.count = 12;
+  l.height = 0.2;
+  l.width = 0.1;
+  s.drum.lifters.push_back(l);
+  return s;
+}
+
+// The lifting scene after 1.2 s.
 Simulation& lifting_charge() {
   static Simulation* sim = [] {
-    Scene s = thesis_drum_scene(150, 1.8, 0, 0.1);
-    LifterSpec l;
-    l.count = 12;
-    l.height = 0.2;
-    l.width = 0.1;
-    s.drum.lifters.push_back(l);
-    auto* out = new Simulation(s);
+    auto* out = new Simulation(lifting_scene());
     out->run_until(1.2);
     return out;
   }();
@@ -229,12 +234,7 @@ TEST(ShellResponse, ABallAtRestOnALiftingFaceLoadsTheSupportsWithItsWeightAndBen
 }
 
 TEST(ShellResponse, TheNodalLoadsAddUpToTheWallLoadsAtEveryStep) {
-  Scene s = thesis_drum_scene(150, 1.8, 0, 0.1);
-  LifterSpec l;
-  l.count = 12;
-  l.height = 0.2;
-  l.width = 0.1;
-  s.drum.lifters.push_back(l);
+  Scene s = lifting_scene();
   add_shell(s);
   s.shell.thickness = 0.1;
   Simulation sim(s);
