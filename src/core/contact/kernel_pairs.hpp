@@ -370,6 +370,7 @@ void Kernel<Model, Shape>::scatter_pairs(ParticleStore& p, PairList& pl, std::si
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
+  Field<double>* const et = kArmsApart ? p.elastic_torque() : nullptr;  // shaped stores only
   double* trial = new_histories(pl);
   const std::int32_t* bj = bj_.data();
   // The partner's three lines kAhead contacts ahead (the lower-id particles come in order), where
@@ -395,7 +396,7 @@ void Kernel<Model, Shape>::scatter_pairs(ParticleStore& p, PairList& pl, std::si
     f_el[i] += ei;
     f_el[j] -= ei;
     if constexpr (kArmsApart) {
-      if (Field<double>* et = p.elastic_torque()) {  // a store with the shape fields
+      if (et != nullptr) {
         (*et)[i] += b_.et_i[c];
         (*et)[j] += b_.et_j[c];
       }

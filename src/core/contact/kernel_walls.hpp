@@ -155,6 +155,7 @@ void Kernel<Model, Shape>::scatter_walls(ParticleStore& p, WallPairList& wl, std
   Vec2* f = p.force.data();
   double* tq = p.torque.data();
   Vec2* f_el = p.elastic_force.data();
+  Field<double>* const et = kArmsApart ? p.elastic_torque() : nullptr;  // shaped stores only
   double dissipated = tot.dissipated, elastic = tot.elastic, max_ratio = tot.max_overlap;
   for (std::size_t c = 0; c < n; ++c) {
     const std::int32_t k = wb_.pair[c];
@@ -165,7 +166,7 @@ void Kernel<Model, Shape>::scatter_walls(ParticleStore& p, WallPairList& wl, std
     tq[i] += wb_.torque[c];
     f_el[i] += Vec2{wb_.ex[c], wb_.ey[c]};
     if constexpr (kArmsApart)
-      if (Field<double>* et = p.elastic_torque()) (*et)[i] += wb_.et[c];
+      if (et != nullptr) (*et)[i] += wb_.et[c];
     dissipated += wb_.diss_law[c];
     elastic += wb_.el_law[c];
     if constexpr (Model::Rolling::kActive) {

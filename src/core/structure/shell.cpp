@@ -36,12 +36,19 @@ Shell::Shell(const Scene& scene, const Walls& walls)
   if (!(depth_ > 0.0)) throw std::invalid_argument("the shell's depth must be positive");
 }
 
+FeVector Shell::nodal_loads(std::span<const WallLoad> records, const Walls& walls,
+                            std::size_t* placed) const {
+  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model_.dofs()));
+  const std::size_t n = map_.add(records, walls.drum_angle(), centre_, depth_, f);
+  if (placed != nullptr) *placed = n;
+  return f;
+}
+
 ShellResponse Shell::respond(std::span<const WallLoad> records, const Walls& walls,
                              bool check) const {
   ShellResponse out;
   const double angle = walls.drum_angle();
-  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model_.dofs()));
-  out.records = map_.add(records, angle, centre_, depth_, f);
+  const FeVector f = nodal_loads(records, walls, &out.records);
   for (const WallLoad& l : records) {
     if (walls.elements()[static_cast<std::size_t>(l.element)].part == WallPart::kWall) continue;
     out.applied += rotate(l.force, -angle) * (-1.0 / depth_);
@@ -68,9 +75,7 @@ ShellResponse Shell::respond(std::span<const WallLoad> records, const Walls& wal
 
 ShellField Shell::field(std::span<const WallLoad> records, const Walls& walls) const {
   const double angle = walls.drum_angle();
-  FeVector f = FeVector::Zero(static_cast<Eigen::Index>(model_.dofs()));
-  map_.add(records, angle, centre_, depth_, f);
-  const FeVector u = model_.solve(f);
+  const FeVector u = model_.solve(nodal_loads(records, walls, nullptr));
   const FeStress stress = model_.stress(u);
   const std::vector<Vec2>& nodes = model_.mesh().nodes;
   ShellField out;

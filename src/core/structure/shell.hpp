@@ -70,6 +70,9 @@ class Shell {
   double depth() const { return depth_; }
 
  private:
+  // The records' loads on the mesh's nodes at the walls' pose; `placed`: how many were placed.
+  FeVector nodal_loads(std::span<const WallLoad> records, const Walls& walls,
+                       std::size_t* placed) const;
   FeModel model_;
   WallLoadMap map_;
   Vec2 centre_{};
